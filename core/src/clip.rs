@@ -1,0 +1,193 @@
+//! Sutherland–Hodgman clipping for the 2D paths, in camera space `(x, y, w)`.
+//!
+//! Triangles are clipped against the near plane `w = near` (so the 2D family drops
+//! exactly what the 3D family rejects per sample) and against a guard band of
+//! [`GUARD_BAND`]× the screen, which keeps projected coordinates small enough for
+//! f32 to place edges to ~1e-4 pixel. New vertices are always interpolated from the
+//! inside endpoint towards the outside one, so two triangles that share an edge get
+//! bit-identical clipped vertices on it (no cracks along a clip line).
+
+use glam::Vec3;
+
+/// Guard band half-extent in units of the screen half-extent (2 = screen plus
+/// half a screen on every side).
+pub const GUARD_BAND: f32 = 2.0;
+
+/// Most vertices a triangle can have after five clip planes.
+pub const MAX_CLIPPED: usize = 8;
+
+/// A convex polygon of at most [`MAX_CLIPPED`] camera-space vertices, no heap.
+#[derive(Clone, Copy, Debug)]
+pub struct ClipPolygon {
+    pub vertices: [Vec3; MAX_CLIPPED],
+    pub len: usize,
+}
+
+impl ClipPolygon {
+    pub fn as_slice(&self) -> &[Vec3] {
+        &self.vertices[..self.len]
+    }
+}
+
+/// A clip plane as a signed distance on camera-space points (`≥ 0` is kept).
+#[derive(Clone, Copy, Debug)]
+pub struct ClipPlane {
+    /// `distance(v) = v.x·k.x + v.y·k.y + v.z·k.z − offset`.
+    pub k: Vec3,
+    pub offset: f32,
+}
+
+impl ClipPlane {
+    #[inline]
+    fn distance(&self, v: Vec3) -> f32 {
+        v.x * self.k.x + v.y * self.k.y + v.z * self.k.z - self.offset
+    }
+}
+
+/// The five planes of the 2D pipeline: near, then the guard band's left, right,
+/// bottom and top (for `x/w ∈ [−G·tan_x, G·tan_x]`, likewise `y`).
+pub fn pipeline_planes(near: f32, tan_half_x: f32, tan_half_y: f32) -> [ClipPlane; 5] {
+    let gx = GUARD_BAND * tan_half_x;
+    let gy = GUARD_BAND * tan_half_y;
+    [
+        ClipPlane {
+            k: Vec3::Z,
+            offset: near,
+        },
+        ClipPlane {
+            k: Vec3::new(1.0, 0.0, gx),
+            offset: 0.0,
+        },
+        ClipPlane {
+            k: Vec3::new(-1.0, 0.0, gx),
+            offset: 0.0,
+        },
+        ClipPlane {
+            k: Vec3::new(0.0, 1.0, gy),
+            offset: 0.0,
+        },
+        ClipPlane {
+            k: Vec3::new(0.0, -1.0, gy),
+            offset: 0.0,
+        },
+    ]
+}
+
+/// Clips triangle `tri` (camera space) against `planes`. Returns `None` when
+/// nothing is left, the polygon otherwise (the triangle itself when no plane cuts it).
+pub fn clip_triangle(tri: [Vec3; 3], planes: &[ClipPlane]) -> Option<ClipPolygon> {
+    let mut poly = ClipPolygon {
+        vertices: [Vec3::ZERO; MAX_CLIPPED],
+        len: 3,
+    };
+    poly.vertices[..3].copy_from_slice(&tri);
+    for plane in planes {
+        let src = poly;
+        let n = src.len;
+        let dist: [f32; MAX_CLIPPED] = std::array::from_fn(|i| {
+            if i < n {
+                plane.distance(src.vertices[i])
+            } else {
+                0.0
+            }
+        });
+        if dist[..n].iter().all(|&d| d >= 0.0) {
+            continue;
+        }
+        poly.len = 0;
+        for i in 0..n {
+            let j = (i + 1) % n;
+            let (vi, vj) = (src.vertices[i], src.vertices[j]);
+            let (di, dj) = (dist[i], dist[j]);
+            let inside_i = di >= 0.0;
+            if inside_i {
+                push(&mut poly, vi);
+            }
+            if inside_i != (dj >= 0.0) {
+                // Canonical direction: from the inside endpoint to the outside one.
+                let (vin, din, vout, dout) = if inside_i {
+                    (vi, di, vj, dj)
+                } else {
+                    (vj, dj, vi, di)
+                };
+                let t = din / (din - dout);
+                push(&mut poly, vin + (vout - vin) * t);
+            }
+        }
+        if poly.len < 3 {
+            return None;
+        }
+    }
+    Some(poly)
+}
+
+#[inline]
+fn push(poly: &mut ClipPolygon, v: Vec3) {
+    // A convex polygon gains at most one vertex per plane; MAX_CLIPPED covers five.
+    if poly.len < MAX_CLIPPED {
+        poly.vertices[poly.len] = v;
+        poly.len += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn untouched_triangle_is_returned_as_is() {
+        let planes = pipeline_planes(0.1, 1.0, 1.0);
+        let tri = [
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(0.1, 0.0, 1.0),
+            Vec3::new(0.0, 0.1, 1.0),
+        ];
+        let p = clip_triangle(tri, &planes).expect("visible");
+        assert_eq!(p.as_slice(), &tri);
+    }
+
+    #[test]
+    fn near_plane_cuts_a_triangle_through_the_eye_plane() {
+        let planes = pipeline_planes(0.5, 1.0, 1.0);
+        let tri = [
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(0.2, 0.0, 2.0),
+            Vec3::new(-0.2, 0.1, 2.0),
+        ];
+        let p = clip_triangle(tri, &planes).expect("partly visible");
+        assert_eq!(p.len, 4);
+        assert!(p.as_slice().iter().all(|v| v.z >= 0.5 - 1e-6));
+    }
+
+    #[test]
+    fn shared_edge_clips_to_identical_vertices_in_both_orders() {
+        let planes = pipeline_planes(0.5, 1.0, 1.0);
+        let (a, b) = (Vec3::new(0.1, 0.3, -0.7), Vec3::new(0.3, -0.2, 3.1));
+        let t1 = clip_triangle([a, b, Vec3::new(0.5, 0.5, 2.0)], &planes).expect("visible");
+        let t2 = clip_triangle([b, a, Vec3::new(-0.5, 0.5, 2.0)], &planes).expect("visible");
+        let on_plane = |p: &ClipPolygon| {
+            p.as_slice()
+                .iter()
+                .copied()
+                .filter(|v| v.z < 0.5 + 1e-3)
+                .collect::<Vec<_>>()
+        };
+        let shared1: Vec<Vec3> = on_plane(&t1);
+        let shared2: Vec<Vec3> = on_plane(&t2);
+        assert!(
+            shared1.iter().any(|v| shared2.contains(v)),
+            "{shared1:?} vs {shared2:?}"
+        );
+    }
+
+    #[test]
+    fn triangle_behind_the_eye_vanishes() {
+        let planes = pipeline_planes(0.1, 1.0, 1.0);
+        let tri = [
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(1.0, 0.0, -1.0),
+            Vec3::new(0.0, 1.0, -2.0),
+        ];
+        assert!(clip_triangle(tri, &planes).is_none());
+    }
+}

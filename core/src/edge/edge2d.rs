@@ -1,0 +1,117 @@
+//! 2D edge functions on projected vertices (paper §3.1).
+//!
+//! Each edge is evaluated relative to its canonical endpoint (the lexicographically
+//! smaller one), `E(p) = (hi − lo) × (p − lo)`, then signed for the triangle. Two
+//! triangles sharing an edge compute the same canonical value bit for bit and
+//! apply opposite signs, so a sample on the edge goes to exactly one of them; a
+//! sample exactly on a vertex gets `E = 0` exactly on both of its edges.
+
+use super::{inside_edge, owns_tie};
+
+/// A projected vertex: pixel coordinates and `1/w` for perspective-correct depth.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScreenVertex {
+    pub x: f32,
+    pub y: f32,
+    pub inv_w: f32,
+}
+
+/// A projected triangle set up for 2D rasterization.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle2D {
+    /// Canonical edge start per edge `i` (opposite vertex `i`).
+    lo: [[f32; 2]; 3],
+    /// `hi − lo` per edge.
+    delta: [[f32; 2]; 3],
+    /// ±1: the edge's sign for this triangle (canonical order × orientation).
+    sign: [f32; 3],
+    pub owns: [bool; 3],
+    /// `1/w` at each vertex.
+    inv_w: [f32; 3],
+    /// Pixel-coordinate bounds of the vertices: `[min_x, min_y, max_x, max_y]`.
+    pub bounds: [f32; 4],
+}
+
+impl Triangle2D {
+    /// Sets up the three edge functions; `None` for triangles that are degenerate
+    /// in f32 after projection (some vertex not strictly inside its opposite edge).
+    pub fn setup(v: &[ScreenVertex; 3]) -> Option<Triangle2D> {
+        let mut t = Triangle2D {
+            lo: [[0.0; 2]; 3],
+            delta: [[0.0; 2]; 3],
+            sign: [1.0; 3],
+            owns: [false; 3],
+            inv_w: [v[0].inv_w, v[1].inv_w, v[2].inv_w],
+            bounds: [
+                v[0].x.min(v[1].x).min(v[2].x),
+                v[0].y.min(v[1].y).min(v[2].y),
+                v[0].x.max(v[1].x).max(v[2].x),
+                v[0].y.max(v[1].y).max(v[2].y),
+            ],
+        };
+        // 1. Canonical endpoints per edge (lexicographic on (x, y)).
+        for i in 0..3 {
+            let a = v[(i + 1) % 3];
+            let b = v[(i + 2) % 3];
+            let (lo, hi, flip) = if (a.x, a.y) <= (b.x, b.y) {
+                (a, b, 1.0)
+            } else {
+                (b, a, -1.0)
+            };
+            t.lo[i] = [lo.x, lo.y];
+            t.delta[i] = [hi.x - lo.x, hi.y - lo.y];
+            t.sign[i] = flip;
+        }
+        // 2. Orientation from edge 0 at its opposite vertex; the triangle is kept
+        //    only if every vertex is strictly inside its opposite edge.
+        let orientation = t.raw(0, v[0].x, v[0].y) * t.sign[0];
+        if !(orientation != 0.0 && orientation.is_finite()) {
+            return None;
+        }
+        let orient = if orientation > 0.0 { 1.0 } else { -1.0 };
+        for i in 0..3 {
+            t.sign[i] *= orient;
+            if !(t.raw(i, v[i].x, v[i].y) * t.sign[i] > 0.0) {
+                return None;
+            }
+            // ∂E/∂x = −Δy·s, ∂E/∂y = Δx·s.
+            t.owns[i] = owns_tie(-t.delta[i][1] * t.sign[i], t.delta[i][0] * t.sign[i]);
+        }
+        Some(t)
+    }
+
+    /// Canonical (unsigned) edge function `(hi − lo) × (p − lo)`.
+    #[inline(always)]
+    fn raw(&self, i: usize, x: f32, y: f32) -> f32 {
+        let [lx, ly] = self.lo[i];
+        let [dx, dy] = self.delta[i];
+        dx * (y - ly) - dy * (x - lx)
+    }
+
+    /// The three signed edge values at pixel point `(x, y)`.
+    #[inline(always)]
+    pub fn edge_values(&self, x: f32, y: f32) -> [f32; 3] {
+        [
+            self.raw(0, x, y) * self.sign[0],
+            self.raw(1, x, y) * self.sign[1],
+            self.raw(2, x, y) * self.sign[2],
+        ]
+    }
+
+    /// Coverage and perspective-correct depth at `(x, y)`: `Some(w)` with
+    /// `1/w = Σ λ_i / w_i`, `λ_i = E_i / ΣE` (paper §3.1).
+    #[inline(always)]
+    pub fn sample(&self, x: f32, y: f32) -> Option<f32> {
+        let e = self.edge_values(x, y);
+        if !(inside_edge(e[0], self.owns[0])
+            && inside_edge(e[1], self.owns[1])
+            && inside_edge(e[2], self.owns[2]))
+        {
+            return None;
+        }
+        let sum = e[0] + e[1] + e[2];
+        let inv_w = e[0] * self.inv_w[0] + e[1] * self.inv_w[1] + e[2] * self.inv_w[2];
+        let w = sum / inv_w;
+        (w > 0.0 && w < f32::INFINITY).then_some(w)
+    }
+}

@@ -1,0 +1,125 @@
+//! 3D edge functions (paper §3.2–3.4).
+//!
+//! For eye `e` and an edge `(a, b)` the edge normal is built from the edge midpoint,
+//! `n = (e − (a+b)/2) × (a − b)` (§3.4 "Numerics"): the two triangles that share an
+//! edge get bitwise negated normals in f32, so they split every sample on it.
+//! With a sample direction `d(x, y) = d0 + x·dx + y·dy` the edge function is
+//! `V(x, y) = n·d = A + x·B + y·C` with `A = n·d0`, `B = n·dx`, `C = n·dy`.
+
+use glam::Vec3;
+
+use super::{inside_edge, owns_tie};
+use crate::camera::View;
+
+/// A triangle set up for 3D rasterization against one view: per edge `i`
+/// (opposite vertex `i`) the coefficients of `E_i(x, y) = A_i + x·B_i + y·C_i`,
+/// normalised so the triangle's inside is `E_i > 0`, and the total volume
+/// `|D| = |det(p0 − e, p1 − e, p2 − e)|`.
+///
+/// Depth is `w = |D| / ΣE_i` (paper Fig. 10), but `ΣE_i` is evaluated as its own
+/// linear function `N·d(x, y)` (`N` the geometric normal; equal to `ΣV_i` in real
+/// arithmetic). Summing the three edge values cancels catastrophically for
+/// triangles that are small against their distance (each `E_i` is a difference of
+/// terms ~10⁵× larger): on 1M-triangle scenes that gave `w` errors of 0.1%.
+///
+/// Every algorithm of the 3D family and the ray caster decide coverage and depth
+/// through [`Triangle3D::sample`] on these coefficients, in one fixed operation
+/// order with no fused multiply-add, so they agree bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle3D {
+    pub a: [f32; 3],
+    pub b: [f32; 3],
+    pub c: [f32; 3],
+    /// `|D|`: `w = |D| / (N·d)`.
+    pub volume: f32,
+    /// `N·d(x, y) = nd[0] + x·nd[1] + y·nd[2]`, sign-normalised like the edges.
+    pub nd: [f32; 3],
+    /// Per edge: does it own samples exactly on it (the §3.4 tie rule)?
+    pub owns: [bool; 3],
+}
+
+/// The midpoint edge normal `(e − (a+b)/2) × (a − b)` of §3.4. Swapping `a` and `b`
+/// negates the result exactly: `a + b` is commutative and `a − b = −(b − a)`.
+#[inline]
+pub fn edge_normal(eye: Vec3, a: Vec3, b: Vec3) -> Vec3 {
+    let mid = (a + b) * 0.5;
+    (eye - mid).cross(a - b)
+}
+
+impl Triangle3D {
+    /// Paper §3.2 setup: three edge normals, their derivatives along the sample
+    /// generator, and the triangle's volume as seen from the eye. `None` when the
+    /// triangle is seen exactly edge-on (`D = 0`) or the values are not finite.
+    #[inline]
+    pub fn setup(p: &[Vec3; 3], view: &View) -> Option<Triangle3D> {
+        let eye = view.eye;
+        // 1. Total volume D = N · (p0 − e) with the geometric normal N; its sign is
+        //    the side the eye sees, and it orients the edge functions.
+        let normal = (p[1] - p[0]).cross(p[2] - p[0]);
+        let d = normal.dot(p[0] - eye);
+        if d == 0.0 || !d.is_finite() {
+            return None;
+        }
+        let sign = if d > 0.0 { 1.0 } else { -1.0 };
+        // 2. Edge i is opposite vertex i: (p[i+1], p[i+2]).
+        let mut t = Triangle3D {
+            a: [0.0; 3],
+            b: [0.0; 3],
+            c: [0.0; 3],
+            volume: d.abs(),
+            nd: [
+                sign * normal.dot(view.d0),
+                sign * normal.dot(view.dx),
+                sign * normal.dot(view.dy),
+            ],
+            owns: [false; 3],
+        };
+        for i in 0..3 {
+            let n = edge_normal(eye, p[(i + 1) % 3], p[(i + 2) % 3]) * sign;
+            t.a[i] = n.dot(view.d0);
+            t.b[i] = n.dot(view.dx);
+            t.c[i] = n.dot(view.dy);
+            t.owns[i] = owns_tie(t.b[i], t.c[i]);
+        }
+        if !(t
+            .a
+            .iter()
+            .chain(&t.b)
+            .chain(&t.c)
+            .chain(&t.nd)
+            .all(|v| v.is_finite()))
+        {
+            return None;
+        }
+        Some(t)
+    }
+
+    /// The three edge values at image point `(x, y)`: `(A + x·B) + y·C`.
+    #[inline(always)]
+    pub fn edge_values(&self, x: f32, y: f32) -> [f32; 3] {
+        [
+            self.a[0] + x * self.b[0] + y * self.c[0],
+            self.a[1] + x * self.b[1] + y * self.c[1],
+            self.a[2] + x * self.b[2] + y * self.c[2],
+        ]
+    }
+
+    /// Coverage and depth of the sample at `(x, y)`: `Some(w)` when all three edges
+    /// contain it (ties by [`owns_tie`]) and `w = |D| / (N·d) ≥ near`.
+    #[inline(always)]
+    pub fn sample(&self, x: f32, y: f32, near: f32) -> Option<f32> {
+        let e = self.edge_values(x, y);
+        if !(inside_edge(e[0], self.owns[0])
+            && inside_edge(e[1], self.owns[1])
+            && inside_edge(e[2], self.owns[2]))
+        {
+            return None;
+        }
+        let facing = self.nd[0] + x * self.nd[1] + y * self.nd[2];
+        if facing <= 0.0 {
+            return None;
+        }
+        let w = self.volume / facing;
+        (w >= near && w < f32::INFINITY).then_some(w)
+    }
+}

@@ -1,0 +1,37 @@
+//! continuum: one renderer for the road between rasterization and ray casting.
+//!
+//! It follows "3D Rasterization: A Bridge between Rasterization and Ray Casting"
+//! (Davidovič et al., GI 2012). Coverage is decided by edge functions — projected
+//! 2D ones, or the paper's 3D (Plücker) ones — and the algorithms differ only in
+//! how they enumerate triangles and samples. Every front end calls [`render`]:
+//!
+//! ```no_run
+//! use continuum::{render, AlgorithmId, PreparedScene, RenderRequest};
+//! let scene = continuum::scene::load_path("scenes/bunny.toml".as_ref()).unwrap();
+//! let prepared = PreparedScene::new(scene);
+//! let camera = prepared.scene.first_camera();
+//! let out = render(&prepared, &RenderRequest { algorithm: AlgorithmId::ThreeDBrute, camera, width: 640, height: 480 }).unwrap();
+//! println!("{}", out.hashes.triangle_id);
+//! ```
+
+pub mod algorithm;
+pub mod bvh;
+pub mod camera;
+pub mod clip;
+pub mod edge;
+pub mod framebuffer;
+pub mod maps;
+pub mod prepared;
+pub mod render;
+pub mod request;
+pub mod scene;
+pub mod shade;
+pub mod stats;
+
+pub use algorithm::{AlgorithmId, Family};
+pub use camera::{Camera, View};
+pub use framebuffer::{BACKGROUND, Framebuffer};
+pub use prepared::PreparedScene;
+pub use render::{RenderError, RenderOutput, RenderRequest, render};
+pub use scene::{Scene, SceneError};
+pub use stats::{Hashes, Stats};

@@ -1,0 +1,100 @@
+//! Images of a framebuffer for people: the colour image, the per-pixel
+//! edge-evaluation heat map, depth, and triangle ids, as RGBA8 or PNG bytes.
+//!
+//! Heat-map scale: a pixel with `n` edge evaluations gets the *inferno* colour at
+//! `t = ln(1 + n) / ln(1 + max)`, where `max` is the largest count in the image
+//! (`Stats::max_edge_evals_per_pixel`); `n = 0` is black, `max` is pale yellow.
+
+use image::{ImageEncoder, RgbaImage};
+
+use crate::framebuffer::{BACKGROUND, Framebuffer};
+
+/// The logarithmic heat-map position of `n` evaluations on a scale topping at `max`.
+pub fn heat_position(n: u32, max: u32) -> f64 {
+    if max == 0 {
+        return 0.0;
+    }
+    (1.0 + f64::from(n)).ln() / (1.0 + f64::from(max)).ln()
+}
+
+/// The heat-map colour of position `t ∈ [0, 1]` (inferno).
+pub fn heat_color(t: f64) -> [u8; 4] {
+    let c = colorous::INFERNO.eval_continuous(t.clamp(0.0, 1.0));
+    [c.r, c.g, c.b, 255]
+}
+
+pub fn color_image(fb: &Framebuffer) -> RgbaImage {
+    from_pixels(fb, fb.color.clone())
+}
+
+pub fn edge_eval_image(fb: &Framebuffer) -> RgbaImage {
+    let max = fb.edge_evals.iter().copied().max().unwrap_or(0);
+    from_pixels(
+        fb,
+        fb.edge_evals
+            .iter()
+            .map(|&n| heat_color(heat_position(n, max)))
+            .collect(),
+    )
+}
+
+/// Depth as grey: nearest visible surface white, farthest dark grey, background black.
+pub fn depth_image(fb: &Framebuffer) -> RgbaImage {
+    let finite = fb.depth.iter().copied().filter(|d| d.is_finite());
+    let (lo, hi) = finite.fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), d| {
+        (lo.min(d), hi.max(d))
+    });
+    let span = (hi - lo).max(f32::MIN_POSITIVE);
+    from_pixels(
+        fb,
+        fb.depth
+            .iter()
+            .map(|&d| {
+                if d.is_finite() {
+                    let g = (255.0 - 200.0 * (d - lo) / span) as u8;
+                    [g, g, g, 255]
+                } else {
+                    [0, 0, 0, 255]
+                }
+            })
+            .collect(),
+    )
+}
+
+/// Triangle ids as arbitrary but stable colours (a hash of the id); background black.
+pub fn triangle_id_image(fb: &Framebuffer) -> RgbaImage {
+    from_pixels(
+        fb,
+        fb.triangle_id
+            .iter()
+            .map(|&id| {
+                if id == BACKGROUND {
+                    [0, 0, 0, 255]
+                } else {
+                    let h = id.wrapping_mul(0x9E37_79B1).rotate_left(13) ^ 0x5bd1_e995;
+                    let [r, g, b, _] = h.to_le_bytes();
+                    [r | 0x30, g | 0x30, b | 0x30, 255]
+                }
+            })
+            .collect(),
+    )
+}
+
+fn from_pixels(fb: &Framebuffer, pixels: Vec<[u8; 4]>) -> RgbaImage {
+    let raw: Vec<u8> = pixels.into_iter().flatten().collect();
+    RgbaImage::from_raw(fb.width, fb.height, raw).expect("buffer has width × height pixels")
+}
+
+/// PNG-encodes an image.
+pub fn png_bytes(img: &RgbaImage) -> Vec<u8> {
+    let mut out = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut out)
+        .write_image(
+            img.as_raw(),
+            img.width(),
+            img.height(),
+            image::ExtendedColorType::Rgba8,
+        )
+        .expect("encoding to memory cannot fail");
+    out
+}

@@ -1,0 +1,74 @@
+//! `Scene` → `PreparedScene`: everything a render needs that does not depend on
+//! the camera, built once (and cached by the server): per-triangle positions and
+//! face normals, the list of drawable (non-degenerate) triangles, and the BVH.
+
+use std::sync::Arc;
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use crate::bvh::SceneBvh;
+use crate::scene::{Bounds, Scene};
+
+/// A scene ready to render from any camera.
+#[derive(Debug)]
+pub struct PreparedScene {
+    pub scene: Arc<Scene>,
+    /// Vertex positions per triangle id.
+    pub triangles: Vec<[Vec3; 3]>,
+    /// Unit geometric normal per triangle id (zero for degenerate triangles).
+    pub face_normals: Vec<Vec3>,
+    /// Ids of the triangles that are drawn: all but the degenerate ones (two equal
+    /// vertices, or an f32 cross product of exactly zero).
+    pub drawable: Vec<u32>,
+    pub bvh: SceneBvh,
+    pub bounds: Bounds,
+    /// Near distance for cameras that give none: 1e-3 of the bounding radius.
+    pub default_near: f32,
+}
+
+impl PreparedScene {
+    pub fn new(scene: Scene) -> PreparedScene {
+        Self::from_arc(Arc::new(scene))
+    }
+
+    pub fn from_arc(scene: Arc<Scene>) -> PreparedScene {
+        let mesh = &scene.mesh;
+        let triangles: Vec<[Vec3; 3]> = (0..mesh.triangle_count())
+            .into_par_iter()
+            .map(|t| mesh.triangle_positions(t))
+            .collect();
+        let raw_normals: Vec<Vec3> = triangles
+            .par_iter()
+            .map(|[a, b, c]| (*b - *a).cross(*c - *a))
+            .collect();
+        let drawable: Vec<u32> = raw_normals
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| **n != Vec3::ZERO && n.is_finite())
+            .map(|(i, _)| i as u32)
+            .collect();
+        let face_normals = raw_normals.iter().map(|n| n.normalize_or_zero()).collect();
+        let bvh = SceneBvh::build(&triangles, &drawable);
+        let bounds = scene.bounds();
+        let radius = if bounds.is_empty() {
+            1.0
+        } else {
+            bounds.radius().max(1e-6)
+        };
+        PreparedScene {
+            triangles,
+            face_normals,
+            drawable,
+            bvh,
+            bounds,
+            default_near: radius * 1e-3,
+            scene,
+        }
+    }
+
+    /// Triangle count, degenerate ones included.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+}

@@ -1,0 +1,137 @@
+//! The one entry point every front end calls: `render(&PreparedScene,
+//! &RenderRequest) -> RenderOutput`.
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::algorithm::{AlgorithmId, render_2dr_brute, render_3dr_brute, render_raycast};
+use crate::camera::{Camera, CameraError, View};
+use crate::framebuffer::Framebuffer;
+use crate::prepared::PreparedScene;
+use crate::shade::shade;
+use crate::stats::{CoverageHistogram, Hashes, Stats};
+
+/// Largest width or height a render accepts.
+pub const MAX_DIMENSION: u32 = 16384;
+
+/// What to render: which algorithm, from where, at what size.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderRequest {
+    pub algorithm: AlgorithmId,
+    pub camera: Camera,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// A request that cannot be rendered, with the field at fault.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{field}: {message}")]
+pub struct RenderError {
+    pub field: &'static str,
+    pub message: String,
+}
+
+impl From<CameraError> for RenderError {
+    fn from(e: CameraError) -> Self {
+        RenderError {
+            field: if e.field == "size" { "size" } else { "camera" },
+            message: e.to_string(),
+        }
+    }
+}
+
+/// Images and statistics of one render.
+#[derive(Clone, Debug)]
+pub struct RenderOutput {
+    pub algorithm: AlgorithmId,
+    /// The viewport in the CLI's words, e.g. `perspective:60`.
+    pub viewport: String,
+    /// The anti-aliasing mode in the CLI's words.
+    pub aa: String,
+    pub view: View,
+    pub framebuffer: Framebuffer,
+    pub stats: Stats,
+    pub hashes: Hashes,
+}
+
+/// The summary document of a render (the `render --json` output).
+#[derive(Clone, Debug, Serialize)]
+pub struct RenderSummary<'a> {
+    pub scene: &'a str,
+    pub algorithm: AlgorithmId,
+    pub camera: &'a str,
+    pub viewport: &'a str,
+    pub aa: &'a str,
+    pub width: u32,
+    pub height: u32,
+    pub stats: &'a Stats,
+    pub hashes: &'a Hashes,
+}
+
+impl RenderOutput {
+    pub fn summary<'a>(&'a self, scene: &'a str, camera: &'a str) -> RenderSummary<'a> {
+        RenderSummary {
+            scene,
+            algorithm: self.algorithm,
+            camera,
+            viewport: &self.viewport,
+            aa: &self.aa,
+            width: self.view.width,
+            height: self.view.height,
+            stats: &self.stats,
+            hashes: &self.hashes,
+        }
+    }
+}
+
+/// Renders `scene` as `request` asks.
+pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOutput, RenderError> {
+    let total = Instant::now();
+    if request.width == 0
+        || request.height == 0
+        || request.width > MAX_DIMENSION
+        || request.height > MAX_DIMENSION
+    {
+        return Err(RenderError {
+            field: "size",
+            message: format!(
+                "{}x{} is out of range: width and height must be in 1..={MAX_DIMENSION}",
+                request.width, request.height
+            ),
+        });
+    }
+    let view = View::new(
+        &request.camera,
+        request.width,
+        request.height,
+        scene.default_near,
+    )?;
+    let mut fb = Framebuffer::new(request.width, request.height);
+    let mut stats = Stats::default();
+
+    match request.algorithm {
+        AlgorithmId::TwoDBrute => render_2dr_brute(scene, &view, &mut fb, &mut stats),
+        AlgorithmId::ThreeDBrute => render_3dr_brute(scene, &view, &mut fb, &mut stats),
+        AlgorithmId::Raycast => render_raycast(scene, &view, &mut fb, &mut stats),
+    }
+
+    let start = Instant::now();
+    shade(scene, &view, &mut fb);
+    stats.time_ms.shading = start.elapsed().as_secs_f64() * 1e3;
+
+    stats.edge_evaluations = fb.edge_evals.iter().map(|&e| u64::from(e)).sum();
+    stats.max_edge_evals_per_pixel = fb.edge_evals.iter().copied().max().unwrap_or(0);
+    stats.coverage_histogram = CoverageHistogram::of(&fb.coverage_writes);
+    let hashes = Hashes::of(&fb);
+    stats.time_ms.total = total.elapsed().as_secs_f64() * 1e3;
+    Ok(RenderOutput {
+        algorithm: request.algorithm,
+        viewport: format!("perspective:{}", request.camera.fov_y_deg),
+        aa: "none".into(),
+        view,
+        framebuffer: fb,
+        stats,
+        hashes,
+    })
+}

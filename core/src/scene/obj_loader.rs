@@ -1,0 +1,108 @@
+//! Wavefront OBJ through `tobj` (triangulated, single index); MTL diffuse colours
+//! become base colours when the library file is present.
+
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+
+use super::validate::{PartLocation, validate_part};
+use super::{Material, Mesh, Scene, SceneError};
+
+pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
+    let file = path.display().to_string();
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let (models, materials) = tobj::load_obj(path, &options).map_err(|e| match e {
+        tobj::LoadError::OpenFileFailed => SceneError::Io {
+            path: file.clone(),
+            message: "cannot open".into(),
+        },
+        other => SceneError::Obj {
+            path: file.clone(),
+            message: other.to_string(),
+        },
+    })?;
+    let mut scene = Scene {
+        name: path
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("scene")
+            .to_string(),
+        source: file.clone(),
+        ..Scene::default()
+    };
+    match materials {
+        Ok(mats) => {
+            scene.materials = mats
+                .iter()
+                .map(|m| {
+                    let d = m.diffuse.unwrap_or([0.8; 3]);
+                    Material {
+                        name: m.name.clone(),
+                        base_color: [d[0], d[1], d[2], m.dissolve.unwrap_or(1.0)],
+                        ..Material::default()
+                    }
+                })
+                .collect();
+        }
+        Err(e) => scene.warnings.push(format!("materials not loaded: {e}")),
+    }
+    let default_material = scene.materials.len() as u32;
+    scene.materials.push(Material::default());
+
+    for (index, model) in models.iter().enumerate() {
+        let m = &model.mesh;
+        let location =
+            PartLocation::part(&file, format!("object '{}' (#{index})", model.name), None);
+        let positions: Vec<Vec3> = m
+            .positions
+            .chunks_exact(3)
+            .map(|c| Vec3::new(c[0], c[1], c[2]))
+            .collect();
+        let triangles: Vec<[u32; 3]> = m
+            .indices
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect();
+        if triangles.is_empty() {
+            continue; // objects with only points or lines
+        }
+        validate_part(&positions, &triangles, &location)?;
+        let normals: Vec<Vec3> = m
+            .normals
+            .chunks_exact(3)
+            .map(|c| Vec3::new(c[0], c[1], c[2]))
+            .collect();
+        let uvs: Vec<Vec2> = m
+            .texcoords
+            .chunks_exact(2)
+            .map(|c| Vec2::new(c[0], c[1]))
+            .collect();
+        let material = m
+            .material_id
+            .filter(|&i| i < default_material as usize)
+            .map_or(default_material, |i| i as u32);
+        let part = Mesh {
+            normals: if normals.len() == positions.len() {
+                normals
+            } else {
+                Vec::new()
+            },
+            uvs: if uvs.len() == positions.len() {
+                uvs
+            } else {
+                Vec::new()
+            },
+            material_ids: vec![material; triangles.len()],
+            positions,
+            triangles,
+        };
+        scene.mesh.append(&part, 0);
+    }
+    scene.validate()?;
+    Ok(scene)
+}

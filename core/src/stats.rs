@@ -1,0 +1,81 @@
+//! What a render did and what it cost: per-stage wall times, counters, the
+//! coverage histogram and hashes of the result buffers.
+
+use serde::Serialize;
+
+use crate::framebuffer::Framebuffer;
+
+/// Wall time of each stage of one render, in milliseconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct StageTimes {
+    /// Triangle setup (transform, clip, bounds, edge coefficients) and binning into bands.
+    pub setup: f64,
+    /// Scene traversal (the ray caster's BVH walk, leaf tests included).
+    pub traversal: f64,
+    /// Per-sample coverage and depth tests over bounding boxes.
+    pub coverage: f64,
+    /// Shading of visible samples.
+    pub shading: f64,
+    pub total: f64,
+}
+
+/// How many pixels got zero, one, or more coverage writes. On a closed mesh seen
+/// from inside (or a plane filling the screen) every pixel must be in `one`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct CoverageHistogram {
+    pub zero: u64,
+    pub one: u64,
+    pub many: u64,
+}
+
+impl CoverageHistogram {
+    pub fn of(coverage_writes: &[u32]) -> CoverageHistogram {
+        let mut h = CoverageHistogram::default();
+        for &c in coverage_writes {
+            match c {
+                0 => h.zero += 1,
+                1 => h.one += 1,
+                _ => h.many += 1,
+            }
+        }
+        h
+    }
+}
+
+/// Counters and timings returned by every render.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Stats {
+    pub time_ms: StageTimes,
+    /// Triangles whose edge functions were set up (2D: clipped sub-triangles).
+    pub triangle_setups: u64,
+    /// Sample-against-triangle coverage tests (three edge functions each).
+    pub edge_evaluations: u64,
+    /// BVH nodes whose children were tested against a ray.
+    pub bvh_nodes_visited: u64,
+    pub coverage_histogram: CoverageHistogram,
+    /// Largest per-pixel edge-evaluation count (the top of the heat map's scale).
+    pub max_edge_evals_per_pixel: u32,
+}
+
+/// Hex xxh3-64 hashes of the result buffers (little-endian bytes), for comparing
+/// renders without shipping images.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Hashes {
+    pub triangle_id: String,
+    pub color: String,
+}
+
+impl Hashes {
+    pub fn of(fb: &Framebuffer) -> Hashes {
+        let ids: Vec<u8> = fb
+            .triangle_id
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let color: Vec<u8> = fb.color.iter().flatten().copied().collect();
+        Hashes {
+            triangle_id: format!("{:016x}", xxhash_rust::xxh3::xxh3_64(&ids)),
+            color: format!("{:016x}", xxhash_rust::xxh3::xxh3_64(&color)),
+        }
+    }
+}

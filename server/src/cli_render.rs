@@ -1,0 +1,109 @@
+//! `continuum render`: one image, its maps and its statistics.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::Args;
+use continuum::request::{parse_algorithm, parse_size};
+use continuum::{AlgorithmId, PreparedScene, RenderRequest, maps, render};
+
+use crate::{CliError, scenes_dir};
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// A built-in scene name, or a .toml, .gltf, .glb or .obj path.
+    #[arg(long)]
+    scene: String,
+    /// Algorithm id: 2dr-brute, 3dr-brute or raycast.
+    #[arg(long, value_parser = |s: &str| parse_algorithm(s).map_err(|e| e.message))]
+    algorithm: AlgorithmId,
+    /// A camera of the scene (by name); default: the scene's first camera.
+    #[arg(long)]
+    camera: Option<String>,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "640x480", value_parser = |s: &str| parse_size(s).map_err(|e| e.message))]
+    size: (u32, u32),
+    /// Write the colour image here (PNG).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Write edge_evals.png, depth.png and triangle_id.png into this folder.
+    #[arg(long)]
+    maps: Option<PathBuf>,
+    /// Print one JSON document with the statistics on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Folder of built-in scenes.
+    #[arg(long)]
+    scenes: Option<PathBuf>,
+}
+
+pub fn run(args: &RenderArgs) -> Result<(), CliError> {
+    let scene =
+        continuum::scene::load_named_or_path(&args.scene, &scenes_dir(args.scenes.as_ref()))
+            .map_err(|e| CliError::Usage(format!("--scene: {e}")))?;
+    let camera = match &args.camera {
+        Some(name) => scene
+            .camera(name)
+            .map_err(|e| CliError::Usage(format!("--camera: {e}")))?,
+        None => scene.first_camera(),
+    };
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    let prepared = PreparedScene::new(scene);
+    let (width, height) = args.size;
+    let request = RenderRequest {
+        algorithm: args.algorithm,
+        camera,
+        width,
+        height,
+    };
+    let out = render(&prepared, &request).map_err(|e| CliError::Usage(format!("--{e}")))?;
+
+    if let Some(path) = &args.out {
+        std::fs::write(path, maps::png_bytes(&maps::color_image(&out.framebuffer)))
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(dir) = &args.maps {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        let fb = &out.framebuffer;
+        for (name, img) in [
+            ("edge_evals.png", maps::edge_eval_image(fb)),
+            ("depth.png", maps::depth_image(fb)),
+            ("triangle_id.png", maps::triangle_id_image(fb)),
+        ] {
+            let path = dir.join(name);
+            std::fs::write(&path, maps::png_bytes(&img))
+                .with_context(|| format!("writing {}", path.display()))?;
+        }
+    }
+    let summary = out.summary(&prepared.scene.name, &request.camera.name);
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&summary).context("encoding JSON")?
+        );
+    } else {
+        let s = &out.stats;
+        println!(
+            "{} {} {}x{}: {:.2} ms (setup {:.2}, traversal {:.2}, coverage {:.2}, shading {:.2}); {} setups, {} edge evaluations, {} BVH nodes; coverage 0/1/many = {}/{}/{}; ids {}",
+            summary.scene,
+            summary.algorithm,
+            width,
+            height,
+            s.time_ms.total,
+            s.time_ms.setup,
+            s.time_ms.traversal,
+            s.time_ms.coverage,
+            s.time_ms.shading,
+            s.triangle_setups,
+            s.edge_evaluations,
+            s.bvh_nodes_visited,
+            s.coverage_histogram.zero,
+            s.coverage_histogram.one,
+            s.coverage_histogram.many,
+            out.hashes.triangle_id
+        );
+    }
+    Ok(())
+}

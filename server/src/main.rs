@@ -1,0 +1,68 @@
+//! `continuum`: the render service, one-off renders, and (later) comparison runs.
+//! With no subcommand it serves the built-in scenes.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+mod cli_render;
+mod serve;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "continuum",
+    version,
+    about = "The road between rasterization and ray casting, rendered and measured"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Serve the HTTP API on the built-in scenes (the default command).
+    Serve(serve::ServeArgs),
+    /// Render one image and print or write what it cost.
+    Render(cli_render::RenderArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Some(Command::Render(args)) => cli_render::run(&args),
+        Some(Command::Serve(args)) => serve::run(&args),
+        None => serve::run(&serve::ServeArgs::default()),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(CliError::Usage(message)) => {
+            eprintln!("error: {message}");
+            ExitCode::from(2)
+        }
+        Err(CliError::Failed(e)) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// How a command failed: a bad argument (exit 2) or a failure while running (exit 1).
+#[derive(Debug)]
+pub enum CliError {
+    Usage(String),
+    Failed(anyhow::Error),
+}
+
+impl From<anyhow::Error> for CliError {
+    fn from(e: anyhow::Error) -> Self {
+        CliError::Failed(e)
+    }
+}
+
+/// The scenes folder: `--scenes`, else the built-in default.
+pub fn scenes_dir(arg: Option<&PathBuf>) -> PathBuf {
+    arg.cloned()
+        .unwrap_or_else(continuum::scene::default_scenes_dir)
+}
