@@ -88,13 +88,13 @@ impl Camera {
                 format!("must be in (0, 180) degrees, got {}", self.fov_y_deg),
             ));
         }
-        if let Some(near) = self.near {
-            if !(near > 0.0 && near.is_finite()) {
-                return Err(camera_error(
-                    "near",
-                    format!("must be positive and finite, got {near}"),
-                ));
-            }
+        if let Some(near) = self.near
+            && !(near > 0.0 && near.is_finite())
+        {
+            return Err(camera_error(
+                "near",
+                format!("must be positive and finite, got {near}"),
+            ));
         }
         Ok(())
     }

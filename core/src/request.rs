@@ -3,8 +3,13 @@
 
 use std::str::FromStr;
 
+use glam::Vec3;
+use serde::Deserialize;
+
 use crate::algorithm::AlgorithmId;
+use crate::camera::Camera;
 use crate::render::MAX_DIMENSION;
+use crate::scene::Scene;
 
 /// A user value that cannot be used, with the field it came from.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -43,6 +48,94 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), FieldError> {
 /// Parses an algorithm id; the error lists the valid ones.
 pub fn parse_algorithm(s: &str) -> Result<AlgorithmId, FieldError> {
     AlgorithmId::from_str(s).map_err(|e| FieldError::new("algorithm", e.to_string()))
+}
+
+/// Parses a viewport. For now only the pinhole: `perspective` (the camera's own
+/// field of view) or `perspective:FOV` (vertical, degrees). Returns the field of
+/// view override.
+pub fn parse_viewport(s: &str) -> Result<Option<f32>, FieldError> {
+    let (kind, arg) = s.split_once(':').map_or((s, None), |(k, a)| (k, Some(a)));
+    match (kind, arg) {
+        ("perspective", None) => Ok(None),
+        ("perspective", Some(a)) => match a.parse::<f32>() {
+            Ok(fov) if fov > 0.0 && fov < 180.0 => Ok(Some(fov)),
+            _ => Err(FieldError::new(
+                "viewport",
+                format!("'{a}' is not a field of view in (0, 180) degrees"),
+            )),
+        },
+        ("orthographic" | "parabolic" | "latlong", _) => Err(FieldError::new(
+            "viewport",
+            format!("'{s}' is not supported yet; supported: perspective, perspective:FOV"),
+        )),
+        _ => Err(FieldError::new(
+            "viewport",
+            format!("unknown viewport '{s}'; supported: perspective, perspective:FOV"),
+        )),
+    }
+}
+
+/// Parses an anti-aliasing mode. Only `none` exists so far.
+pub fn parse_aa(s: &str) -> Result<(), FieldError> {
+    match s {
+        "none" => Ok(()),
+        _ => Err(FieldError::new(
+            "aa",
+            format!("unknown or unsupported mode '{s}'; supported: none"),
+        )),
+    }
+}
+
+/// A camera as a request gives it: a scene camera's name, or an explicit one.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(untagged)]
+pub enum CameraSpec {
+    Named(String),
+    Explicit(ExplicitCamera),
+}
+
+/// `{ "eye": [x,y,z], "target": [x,y,z], "up": [x,y,z], "fov_y": 60, "near": 0.01 }`
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExplicitCamera {
+    pub eye: [f32; 3],
+    pub target: [f32; 3],
+    #[serde(default = "default_up")]
+    pub up: [f32; 3],
+    #[serde(default = "default_fov")]
+    pub fov_y: f32,
+    pub near: Option<f32>,
+}
+
+fn default_up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+fn default_fov() -> f32 {
+    60.0
+}
+
+impl CameraSpec {
+    /// The camera this names in `scene` (`None`: the scene's first camera).
+    pub fn resolve(spec: Option<&CameraSpec>, scene: &Scene) -> Result<Camera, FieldError> {
+        let camera = match spec {
+            None => scene.first_camera(),
+            Some(CameraSpec::Named(name)) => scene
+                .camera(name)
+                .map_err(|e| FieldError::new("camera", e.to_string()))?,
+            Some(CameraSpec::Explicit(c)) => Camera {
+                name: "custom".into(),
+                eye: Vec3::from(c.eye),
+                target: Vec3::from(c.target),
+                up: Vec3::from(c.up),
+                fov_y_deg: c.fov_y,
+                near: c.near,
+            },
+        };
+        camera
+            .validate()
+            .map_err(|e| FieldError::new("camera", e.to_string()))?;
+        Ok(camera)
+    }
 }
 
 #[cfg(test)]

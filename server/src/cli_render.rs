@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use continuum::request::{parse_algorithm, parse_size};
+use continuum::request::{parse_aa, parse_algorithm, parse_size, parse_viewport};
 use continuum::{AlgorithmId, PreparedScene, RenderRequest, maps, render};
 
 use crate::{CliError, scenes_dir};
@@ -20,6 +20,12 @@ pub struct RenderArgs {
     /// A camera of the scene (by name); default: the scene's first camera.
     #[arg(long)]
     camera: Option<String>,
+    /// Viewport: perspective (the camera's field of view) or perspective:FOV.
+    #[arg(long, default_value = "perspective")]
+    viewport: String,
+    /// Anti-aliasing mode (only `none` so far).
+    #[arg(long, default_value = "none")]
+    aa: String,
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "640x480", value_parser = |s: &str| parse_size(s).map_err(|e| e.message))]
     size: (u32, u32),
@@ -38,15 +44,21 @@ pub struct RenderArgs {
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
+    let fov_override =
+        parse_viewport(&args.viewport).map_err(|e| CliError::Usage(format!("--{e}")))?;
+    parse_aa(&args.aa).map_err(|e| CliError::Usage(format!("--{e}")))?;
     let scene =
         continuum::scene::load_named_or_path(&args.scene, &scenes_dir(args.scenes.as_ref()))
             .map_err(|e| CliError::Usage(format!("--scene: {e}")))?;
-    let camera = match &args.camera {
+    let mut camera = match &args.camera {
         Some(name) => scene
             .camera(name)
             .map_err(|e| CliError::Usage(format!("--camera: {e}")))?,
         None => scene.first_camera(),
     };
+    if let Some(fov) = fov_override {
+        camera.fov_y_deg = fov;
+    }
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }

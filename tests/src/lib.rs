@@ -185,3 +185,97 @@ pub fn explain_2d_3d(
     }
     report
 }
+
+/// A scene made in code: `triangles` over `positions`, one default material, one camera.
+pub fn scene_from_triangles(
+    positions: Vec<glam::Vec3>,
+    triangles: Vec<[u32; 3]>,
+    camera: Camera,
+) -> PreparedScene {
+    let n = triangles.len();
+    let scene = continuum::Scene {
+        name: "test".into(),
+        source: "test".into(),
+        mesh: continuum::scene::Mesh {
+            positions,
+            triangles,
+            material_ids: vec![0; n],
+            ..Default::default()
+        },
+        materials: vec![continuum::scene::Material::default()],
+        cameras: vec![camera],
+        ..Default::default()
+    };
+    scene.validate().expect("test scene is valid");
+    PreparedScene::new(scene)
+}
+
+/// A binary glTF (`.glb`) from a JSON document and one binary buffer.
+pub fn glb(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
+    let mut j = serde_json::to_vec(json).expect("json");
+    while !j.len().is_multiple_of(4) {
+        j.push(b' ');
+    }
+    let mut b = bin.to_vec();
+    while !b.len().is_multiple_of(4) {
+        b.push(0);
+    }
+    let total = 12 + 8 + j.len() + if b.is_empty() { 0 } else { 8 + b.len() };
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(j.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&j);
+    if !b.is_empty() {
+        out.extend_from_slice(&(b.len() as u32).to_le_bytes());
+        out.extend_from_slice(b"BIN\0");
+        out.extend_from_slice(&b);
+    }
+    out
+}
+
+/// A one-mesh `.glb` with the given positions and u16 indices (mode 4 unless `mode`).
+pub fn triangle_glb(positions: &[[f32; 3]], indices: &[u16], mode: u32) -> Vec<u8> {
+    let mut bin: Vec<u8> = positions
+        .iter()
+        .flatten()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    let pos_len = bin.len();
+    bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+    let finite: Vec<[f32; 3]> = positions
+        .iter()
+        .copied()
+        .filter(|p| p.iter().all(|v| v.is_finite()))
+        .collect();
+    let min: Vec<f32> = (0..3)
+        .map(|k| finite.iter().map(|p| p[k]).fold(f32::INFINITY, f32::min))
+        .collect();
+    let max: Vec<f32> = (0..3)
+        .map(|k| {
+            finite
+                .iter()
+                .map(|p| p[k])
+                .fold(f32::NEG_INFINITY, f32::max)
+        })
+        .collect();
+    let json = serde_json::json!({
+        "asset": { "version": "2.0" },
+        "scene": 0,
+        "scenes": [{ "nodes": [0] }],
+        "nodes": [{ "mesh": 0 }],
+        "meshes": [{ "name": "part", "primitives": [{ "attributes": { "POSITION": 0 }, "indices": 1, "mode": mode }] }],
+        "buffers": [{ "byteLength": bin.len() }],
+        "bufferViews": [
+            { "buffer": 0, "byteOffset": 0, "byteLength": pos_len },
+            { "buffer": 0, "byteOffset": pos_len, "byteLength": indices.len() * 2 }
+        ],
+        "accessors": [
+            { "bufferView": 0, "componentType": 5126, "count": positions.len(), "type": "VEC3", "min": min, "max": max },
+            { "bufferView": 1, "componentType": 5123, "count": indices.len(), "type": "SCALAR" }
+        ]
+    });
+    glb(&json, &bin)
+}

@@ -33,11 +33,12 @@ pub enum AlgorithmId {
 
 /// The family an algorithm belongs to: within a family results agree bit for bit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
 pub enum Family {
     /// Projected 2D edge functions.
+    #[serde(rename = "2d")]
     TwoD,
     /// 3D edge functions (rasterizers and the ray caster).
+    #[serde(rename = "3d")]
     ThreeD,
 }
 

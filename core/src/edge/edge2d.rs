@@ -69,9 +69,10 @@ impl Triangle2D {
             return None;
         }
         let orient = if orientation > 0.0 { 1.0 } else { -1.0 };
-        for i in 0..3 {
+        for (i, vertex) in v.iter().enumerate() {
             t.sign[i] *= orient;
-            if !(t.raw(i, v[i].x, v[i].y) * t.sign[i] > 0.0) {
+            let inside = t.raw(i, vertex.x, vertex.y) * t.sign[i];
+            if inside.is_nan() || inside <= 0.0 {
                 return None;
             }
             // ∂E/∂x = −Δy·s, ∂E/∂y = Δx·s.

@@ -41,18 +41,41 @@ fn load(bytes: &[u8], file: &str, name: String, base: Option<&Path>) -> Result<S
         message: e.to_string(),
     };
     let gltf = gltf::Gltf::from_slice(bytes).map_err(gltf_err)?;
-    if base.is_none() {
-        if let Some(b) = gltf.document.buffers().find(
+    // The gltf crate reads accessors with unchecked arithmetic on some malformed
+    // inputs; a panic there must become an error, not take the caller down.
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        read_document(&gltf, file, name, base)
+    }))
+    .unwrap_or_else(|_| {
+        Err(SceneError::Gltf {
+            path: file.to_string(),
+            message: "malformed accessor or buffer data".into(),
+        })
+    })
+}
+
+fn read_document(
+    gltf: &gltf::Gltf,
+    file: &str,
+    name: String,
+    base: Option<&Path>,
+) -> Result<Scene, SceneError> {
+    let gltf_err = |e: gltf::Error| SceneError::Gltf {
+        path: file.to_string(),
+        message: e.to_string(),
+    };
+    if base.is_none()
+        && let Some(b) = gltf.document.buffers().find(
             |b| matches!(b.source(), gltf::buffer::Source::Uri(uri) if !uri.starts_with("data:")),
-        ) {
-            return Err(SceneError::Gltf {
-                path: file.to_string(),
-                message: format!(
-                    "buffer {} refers to an external file; only self-contained .glb files are accepted here",
-                    b.index()
-                ),
-            });
-        }
+        )
+    {
+        return Err(SceneError::Gltf {
+            path: file.to_string(),
+            message: format!(
+                "buffer {} refers to an external file; only self-contained .glb files are accepted here",
+                b.index()
+            ),
+        });
     }
     let buffers =
         gltf::import_buffers(&gltf.document, base, gltf.blob.clone()).map_err(gltf_err)?;
@@ -220,6 +243,13 @@ fn read_primitive(
     buffers: &[gltf::buffer::Data],
     location: &PartLocation,
 ) -> Result<Mesh, SceneError> {
+    // The gltf reader underflows on zero-length accessors: refuse them first.
+    let empty = |a: Option<gltf::Accessor>| a.is_some_and(|a| a.count() == 0);
+    if empty(prim.get(&gltf::Semantic::Positions)) || empty(prim.indices()) {
+        return Err(SceneError::Empty {
+            location: location.to_string(),
+        });
+    }
     let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
     let positions: Vec<Vec3> = reader
         .read_positions()
@@ -269,7 +299,7 @@ fn assemble_triangles(
 ) -> Result<Vec<[u32; 3]>, SceneError> {
     match mode {
         Mode::Triangles => {
-            if idx.len() % 3 != 0 {
+            if !idx.len().is_multiple_of(3) {
                 return Err(SceneError::Invalid {
                     location: location.to_string(),
                     problem: format!(

@@ -15,6 +15,14 @@ fn three_d_family_is_bitwise_identical_on_every_builtin_scene_and_camera() {
     for name in builtin_scenes() {
         let scene = prepared(&name);
         assert!(scene.scene.cameras.len() >= 2, "{name} needs two cameras");
+        assert!(
+            scene
+                .scene
+                .cameras
+                .iter()
+                .any(|c| triangles_through_eye_plane(&scene, c) > 0),
+            "{name} needs a camera inside the geometry, with triangles through its eye plane"
+        );
         for camera in &scene.scene.cameras {
             let brute = render_with(&scene, AlgorithmId::ThreeDBrute, camera, W, H);
             let ray = render_with(&scene, AlgorithmId::Raycast, camera, W, H);
@@ -36,6 +44,22 @@ fn three_d_family_is_bitwise_identical_on_every_builtin_scene_and_camera() {
         }
     }
     assert!(checked >= 14, "only {checked} scene cameras checked");
+}
+
+/// How many drawable triangles have vertices on both sides of the camera's eye plane.
+fn triangles_through_eye_plane(
+    scene: &continuum::PreparedScene,
+    camera: &continuum::Camera,
+) -> usize {
+    let forward = (camera.target - camera.eye).normalize();
+    scene
+        .drawable
+        .iter()
+        .filter(|&&id| {
+            let w = scene.triangles[id as usize].map(|p| (p - camera.eye).dot(forward));
+            w.iter().any(|&v| v < 0.0) && w.iter().any(|&v| v > 0.0)
+        })
+        .count()
 }
 
 /// Checks one scene and camera; returns the report for totals.

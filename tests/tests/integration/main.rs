@@ -1,3 +1,6 @@
 //! One integration-test binary, a module per topic.
 
 mod agreement;
+mod loaders;
+mod tie_rules;
+mod watertight;

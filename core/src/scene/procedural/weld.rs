@@ -24,14 +24,13 @@ pub(crate) fn weld(points: &[DVec3], tol: f64) -> (Vec<Vec3>, Vec<u32>) {
         'search: for dx in -1..=1 {
             for dy in -1..=1 {
                 for dz in -1..=1 {
-                    if let Some(list) = grid.get(&(cx + dx, cy + dy, cz + dz)) {
-                        if let Some(&i) = list
+                    if let Some(list) = grid.get(&(cx + dx, cy + dy, cz + dz))
+                        && let Some(&i) = list
                             .iter()
                             .find(|&&i| unique[i as usize].distance(p) <= tol)
-                        {
-                            found = Some(i);
-                            break 'search;
-                        }
+                    {
+                        found = Some(i);
+                        break 'search;
                     }
                 }
             }

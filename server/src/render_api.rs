@@ -1,0 +1,262 @@
+//! The render endpoints and the listings.
+
+use std::sync::Arc;
+
+use axum::Json;
+use axum::body::Bytes;
+use axum::extract::{Query, State};
+use axum::http::header;
+use axum::response::{IntoResponse, Response};
+use base64::Engine;
+use continuum::request::{
+    CameraSpec, FieldError, parse_aa, parse_algorithm, parse_size, parse_viewport,
+};
+use continuum::{AlgorithmId, RenderOutput, RenderRequest, maps};
+use serde::Deserialize;
+use serde_json::{Value, json};
+
+use crate::error::ApiError;
+use crate::state::AppState;
+
+/// A RenderRequest, in the CLI's words.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderBody {
+    pub scene: String,
+    pub algorithm: String,
+    pub camera: Option<CameraSpec>,
+    pub viewport: Option<String>,
+    pub aa: Option<String>,
+    pub size: Option<String>,
+    pub outputs: Option<Vec<String>>,
+}
+
+/// Image outputs a request may ask for.
+const OUTPUTS: [&str; 4] = ["color", "edge_evals", "depth", "triangle_id"];
+
+/// A body checked against the limits, ready to render.
+struct Checked {
+    scene: String,
+    algorithm: AlgorithmId,
+    camera: Option<CameraSpec>,
+    fov_override: Option<f32>,
+    size: (u32, u32),
+}
+
+fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
+    let names = state.scene_names();
+    if !names.contains(&body.scene) {
+        return Err(ApiError::bad_request(
+            "scene",
+            format!(
+                "unknown scene '{}'; scenes are: {}",
+                body.scene,
+                names.join(", ")
+            ),
+        ));
+    }
+    let algorithm = parse_algorithm(&body.algorithm)?;
+    let size = parse_size(body.size.as_deref().unwrap_or("640x480"))?;
+    if u64::from(size.0) * u64::from(size.1) > state.limits.max_pixels {
+        return Err(FieldError::new(
+            "size",
+            format!(
+                "{}x{} exceeds the limit of {} pixels",
+                size.0, size.1, state.limits.max_pixels
+            ),
+        )
+        .into());
+    }
+    let fov_override = body
+        .viewport
+        .as_deref()
+        .map(parse_viewport)
+        .transpose()?
+        .flatten();
+    body.aa.as_deref().map(parse_aa).transpose()?;
+    if let Some(bad) = body
+        .outputs
+        .iter()
+        .flatten()
+        .find(|o| !OUTPUTS.contains(&o.as_str()))
+    {
+        return Err(ApiError::bad_request(
+            "outputs",
+            format!(
+                "unknown output '{bad}'; outputs are: {}",
+                OUTPUTS.join(", ")
+            ),
+        ));
+    }
+    Ok(Checked {
+        scene: body.scene.clone(),
+        algorithm,
+        camera: body.camera.clone(),
+        fov_override,
+        size,
+    })
+}
+
+/// Renders on the blocking pool, at most `max_concurrent_renders` at once.
+async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, String), ApiError> {
+    let permit = state
+        .renders
+        .clone()
+        .try_acquire_owned()
+        .map_err(|_| ApiError::overloaded())?;
+    let job_state = state.clone();
+    let result = tokio::task::spawn_blocking(move || {
+        let _permit = permit;
+        let prepared = job_state.prepared(&c.scene)?;
+        let mut camera = CameraSpec::resolve(c.camera.as_ref(), &prepared.scene)?;
+        if let Some(fov) = c.fov_override {
+            camera.fov_y_deg = fov;
+        }
+        let request = RenderRequest {
+            algorithm: c.algorithm,
+            camera,
+            width: c.size.0,
+            height: c.size.1,
+        };
+        let out = continuum::render(&prepared, &request)
+            .map_err(|e| ApiError::bad_request(e.field, e.to_string()))?;
+        Ok((out, prepared.scene.name.clone(), request.camera.name))
+    })
+    .await;
+    result.map_err(|e| ApiError::internal(format!("render failed: {e}")))?
+}
+
+fn image(out: &RenderOutput, name: &str) -> Vec<u8> {
+    let fb = &out.framebuffer;
+    let img = match name {
+        "edge_evals" => maps::edge_eval_image(fb),
+        "depth" => maps::depth_image(fb),
+        "triangle_id" => maps::triangle_id_image(fb),
+        _ => maps::color_image(fb),
+    };
+    maps::png_bytes(&img)
+}
+
+/// `POST /api/render`.
+pub async fn render_json(
+    State(state): State<Arc<AppState>>,
+    body: Bytes,
+) -> Result<Json<Value>, ApiError> {
+    let body: RenderBody = serde_json::from_slice(&body).map_err(|e| json_error(&e))?;
+    let checked = check(&body, &state)?;
+    let (out, scene, camera) = run(state, checked).await?;
+    let mut doc = serde_json::to_value(out.summary(&scene, &camera))
+        .map_err(|e| ApiError::internal(e.to_string()))?;
+    let outputs = body.outputs.unwrap_or_else(|| vec!["color".into()]);
+    let images: serde_json::Map<String, Value> = outputs
+        .iter()
+        .map(|o| {
+            let png = base64::engine::general_purpose::STANDARD.encode(image(&out, o));
+            (o.clone(), Value::String(png))
+        })
+        .collect();
+    doc["images"] = Value::Object(images);
+    Ok(Json(doc))
+}
+
+/// Query form of [`RenderBody`] for `GET /api/render.png`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderQuery {
+    scene: String,
+    algorithm: String,
+    camera: Option<String>,
+    viewport: Option<String>,
+    aa: Option<String>,
+    size: Option<String>,
+    output: Option<String>,
+}
+
+/// `GET /api/render.png`.
+pub async fn render_png(
+    State(state): State<Arc<AppState>>,
+    query: Result<Query<RenderQuery>, axum::extract::rejection::QueryRejection>,
+) -> Result<Response, ApiError> {
+    let Query(q) = query.map_err(|e| {
+        let text = e.body_text();
+        ApiError::bad_request(
+            &unknown_or_missing_field(&text).unwrap_or_else(|| "query".into()),
+            text,
+        )
+    })?;
+    let output = q.output.clone().unwrap_or_else(|| "color".into());
+    let body = RenderBody {
+        scene: q.scene,
+        algorithm: q.algorithm,
+        camera: q.camera.map(CameraSpec::Named),
+        viewport: q.viewport,
+        aa: q.aa,
+        size: q.size,
+        outputs: Some(vec![output.clone()]),
+    };
+    let checked = check(&body, &state).map_err(|mut e| {
+        if e.field.as_deref() == Some("outputs") {
+            e.field = Some("output".into());
+        }
+        e
+    })?;
+    let (out, _, _) = run(state, checked).await?;
+    Ok(([(header::CONTENT_TYPE, "image/png")], image(&out, &output)).into_response())
+}
+
+/// `GET /api/scenes`: names, triangle counts and cameras.
+pub async fn scenes(State(state): State<Arc<AppState>>) -> Result<Json<Value>, ApiError> {
+    let list = tokio::task::spawn_blocking(move || {
+        state
+            .scene_names()
+            .into_iter()
+            .map(|name| match state.prepared(&name) {
+                Ok(p) => json!({
+                    "name": name,
+                    "triangles": p.triangle_count(),
+                    "cameras": p.scene.camera_names(),
+                    "lights": p.scene.lights.len(),
+                }),
+                Err(e) => json!({ "name": name, "error": e.error }),
+            })
+            .collect::<Vec<_>>()
+    })
+    .await
+    .map_err(|e| ApiError::internal(e.to_string()))?;
+    Ok(Json(json!({ "scenes": list })))
+}
+
+/// `GET /api/algorithms`.
+pub async fn algorithms() -> Json<Value> {
+    let list: Vec<Value> = AlgorithmId::ALL
+        .iter()
+        .map(|a| {
+            json!({
+                "id": a.as_str(),
+                "family": a.family(),
+                "description": a.description(),
+                "viewports": ["perspective"],
+                "aa": ["none"],
+            })
+        })
+        .collect();
+    Json(json!({ "algorithms": list }))
+}
+
+/// A JSON body error → 400 naming the unknown or missing field, else `body`.
+fn json_error(e: &serde_json::Error) -> ApiError {
+    let text = e.to_string();
+    let field = unknown_or_missing_field(&text).unwrap_or_else(|| "body".into());
+    ApiError::bad_request(&field, format!("invalid request body: {text}"))
+}
+
+/// Pulls the field name out of serde's "unknown field `x`" / "missing field `x`".
+fn unknown_or_missing_field(text: &str) -> Option<String> {
+    for marker in ["unknown field `", "missing field `"] {
+        if let Some(start) = text.find(marker) {
+            let rest = &text[start + marker.len()..];
+            return rest.find('`').map(|end| rest[..end].to_string());
+        }
+    }
+    None
+}

@@ -1,0 +1,218 @@
+//! The `continuum` binary as a user runs it.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn continuum(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_continuum"))
+        .args(args)
+        .env("CONTINUUM_SCENES", scenes())
+        .output()
+        .expect("run continuum")
+}
+
+fn scenes() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes")
+}
+
+fn out_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("continuum-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+#[test]
+fn render_json_has_the_documented_keys() {
+    let out = continuum(&[
+        "render",
+        "--scene",
+        "box",
+        "--algorithm",
+        "3dr-brute",
+        "--size",
+        "64x48",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value =
+        serde_json::from_slice(&out.stdout).expect("stdout is one JSON document");
+    for key in [
+        "scene",
+        "algorithm",
+        "viewport",
+        "aa",
+        "width",
+        "height",
+        "stats",
+        "hashes",
+    ] {
+        assert!(doc.get(key).is_some(), "missing {key}: {doc}");
+    }
+    assert_eq!(doc["scene"], "box");
+    assert_eq!(doc["algorithm"], "3dr-brute");
+    assert_eq!(
+        (doc["width"].as_u64(), doc["height"].as_u64()),
+        (Some(64), Some(48))
+    );
+    let stats = &doc["stats"];
+    for key in ["setup", "traversal", "coverage", "shading", "total"] {
+        assert!(stats["time_ms"][key].is_number(), "time_ms.{key}: {stats}");
+    }
+    for key in ["triangle_setups", "edge_evaluations", "bvh_nodes_visited"] {
+        assert!(stats[key].is_u64(), "{key}: {stats}");
+    }
+    let h = &stats["coverage_histogram"];
+    let total: u64 = ["zero", "one", "many"]
+        .iter()
+        .map(|k| h[k].as_u64().expect("count"))
+        .sum();
+    assert_eq!(total, 64 * 48);
+    for key in ["triangle_id", "color"] {
+        let hex = doc["hashes"][key].as_str().expect("hex string");
+        assert!(
+            hex.len() == 16 && hex.chars().all(|c| c.is_ascii_hexdigit()),
+            "{hex}"
+        );
+    }
+}
+
+#[test]
+fn render_writes_the_image_and_maps() {
+    let dir = out_dir("maps");
+    let png = dir.join("bunny.png");
+    let maps = dir.join("maps");
+    let out = continuum(&[
+        "render",
+        "--scene",
+        "bunny",
+        "--algorithm",
+        "raycast",
+        "--camera",
+        "front",
+        "--size",
+        "96x72",
+        "--out",
+        png.to_str().expect("utf-8"),
+        "--maps",
+        maps.to_str().expect("utf-8"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for file in [
+        png,
+        maps.join("edge_evals.png"),
+        maps.join("depth.png"),
+        maps.join("triangle_id.png"),
+    ] {
+        let bytes = std::fs::read(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+        assert_eq!(&bytes[1..4], b"PNG", "{}", file.display());
+    }
+}
+
+#[test]
+fn scenes_load_by_path_too() {
+    let glb = scenes().join("assets/Box.glb");
+    let out = continuum(&[
+        "render",
+        "--scene",
+        glb.to_str().expect("utf-8"),
+        "--algorithm",
+        "2dr-brute",
+        "--size",
+        "32x32",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn bad_arguments_exit_2_naming_the_argument() {
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["render", "--scene", "box", "--algorithm", "zbuffer"],
+            "--algorithm",
+        ),
+        (
+            &[
+                "render",
+                "--scene",
+                "box",
+                "--algorithm",
+                "raycast",
+                "--size",
+                "0x10",
+            ],
+            "--size",
+        ),
+        (
+            &["render", "--scene", "nosuch", "--algorithm", "raycast"],
+            "--scene",
+        ),
+        (
+            &[
+                "render",
+                "--scene",
+                "box",
+                "--algorithm",
+                "raycast",
+                "--camera",
+                "nosuch",
+            ],
+            "--camera",
+        ),
+        (
+            &[
+                "render",
+                "--scene",
+                "/nonexistent/x.glb",
+                "--algorithm",
+                "raycast",
+            ],
+            "--scene",
+        ),
+        (&["render", "--algorithm", "raycast"], "--scene"),
+        (
+            &[
+                "render",
+                "--scene",
+                "box",
+                "--algorithm",
+                "raycast",
+                "--viewport",
+                "fisheye",
+            ],
+            "--viewport",
+        ),
+        (
+            &[
+                "render",
+                "--scene",
+                "box",
+                "--algorithm",
+                "raycast",
+                "--aa",
+                "msaa:3",
+            ],
+            "--aa",
+        ),
+    ];
+    for (args, named) in cases {
+        let out = continuum(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains(named),
+            "{args:?} should name {named}: {stderr}"
+        );
+    }
+}

@@ -1,0 +1,243 @@
+//! Scene loading: every format, and errors that name the file, mesh, primitive and
+//! index at fault.
+
+use std::path::PathBuf;
+
+use continuum::PreparedScene;
+use continuum::scene::{SceneError, load_path};
+use continuum_tests::{builtin_scenes, prepared, triangle_glb};
+
+fn temp_file(name: &str, bytes: &[u8]) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("continuum-loaders-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).expect("write temp file");
+    path
+}
+
+fn load_err(name: &str, bytes: &[u8]) -> String {
+    let path = temp_file(name, bytes);
+    match load_path(&path) {
+        Ok(_) => panic!("{name} loaded"),
+        Err(e) => e.to_string(),
+    }
+}
+
+const QUAD: [[f32; 3]; 4] = [
+    [0.0, 0.0, 0.0],
+    [1.0, 0.0, 0.0],
+    [1.0, 1.0, 0.0],
+    [0.0, 1.0, 0.0],
+];
+
+#[test]
+fn a_valid_glb_loads() {
+    let path = temp_file("quad.glb", &triangle_glb(&QUAD, &[0, 1, 2, 0, 2, 3], 4));
+    let scene = load_path(&path).expect("loads");
+    assert_eq!(scene.mesh.triangle_count(), 2);
+    assert_eq!(scene.name, "quad");
+}
+
+#[test]
+fn malformed_gltf_is_a_clear_error() {
+    let msg = load_err(
+        "broken.glb",
+        b"glTF\x02\x00\x00\x00garbage that is not a glb",
+    );
+    assert!(
+        msg.contains("broken.glb") && msg.contains("not a valid glTF"),
+        "{msg}"
+    );
+    let msg = load_err("broken.gltf", b"{ \"asset\": ");
+    assert!(
+        msg.contains("broken.gltf") && msg.contains("not a valid glTF"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn nan_vertex_is_named() {
+    let mut positions = QUAD;
+    positions[2][1] = f32::NAN;
+    let msg = load_err("nan.glb", &triangle_glb(&positions, &[0, 1, 2, 0, 2, 3], 4));
+    for part in [
+        "nan.glb",
+        "mesh 'part' (#0)",
+        "primitive 0",
+        "vertex 2",
+        "non-finite",
+    ] {
+        assert!(msg.contains(part), "'{part}' missing from: {msg}");
+    }
+}
+
+#[test]
+fn out_of_range_index_is_named() {
+    let msg = load_err("range.glb", &triangle_glb(&QUAD, &[0, 1, 2, 0, 2, 9], 4));
+    for part in [
+        "range.glb",
+        "mesh 'part' (#0)",
+        "primitive 0",
+        "index 5",
+        "is 9",
+        "out of range for 4 vertices",
+    ] {
+        assert!(msg.contains(part), "'{part}' missing from: {msg}");
+    }
+}
+
+#[test]
+fn non_triangle_modes_are_refused_and_strips_are_assembled() {
+    let msg = load_err("lines.glb", &triangle_glb(&QUAD, &[0, 1, 2, 3], 1));
+    assert!(
+        msg.contains("lines.glb") && msg.contains("Lines") && msg.contains("TRIANGLES"),
+        "{msg}"
+    );
+    let strip = temp_file("strip.glb", &triangle_glb(&QUAD, &[0, 1, 3, 2], 5));
+    assert_eq!(
+        load_path(&strip)
+            .expect("strip loads")
+            .mesh
+            .triangle_count(),
+        2
+    );
+    let fan = temp_file("fan.glb", &triangle_glb(&QUAD, &[0, 1, 2, 3], 6));
+    assert_eq!(load_path(&fan).expect("fan loads").mesh.triangle_count(), 2);
+}
+
+#[test]
+fn empty_mesh_is_an_error() {
+    let msg = load_err("empty.glb", &triangle_glb(&QUAD, &[], 4));
+    assert!(
+        msg.contains("empty.glb") && msg.contains("primitive 0") && msg.contains("empty"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn obj_loads_and_its_errors_are_named() {
+    let path = temp_file(
+        "quad.obj",
+        b"o quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n",
+    );
+    let scene = load_path(&path).expect("obj loads");
+    assert_eq!(scene.mesh.triangle_count(), 2);
+    let msg = load_err("nan.obj", b"o bad\nv 0 0 0\nv 1 nan 0\nv 1 1 0\nf 1 2 3\n");
+    assert!(
+        msg.contains("nan.obj") && msg.contains("object 'bad'") && msg.contains("vertex 1"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn scene_file_errors_name_the_key() {
+    let msg = load_err(
+        "typo.toml",
+        b"[[mesh]]\ngenerator = \"grid\"\nparams = { size = [1.0, 1.0], divisons = [2, 2] }\n",
+    );
+    assert!(
+        msg.contains("typo.toml") && msg.contains("divisons"),
+        "{msg}"
+    );
+    let msg = load_err(
+        "key.toml",
+        b"[[mesh]]\ngenerator = \"sphere\"\ncolour = 3\n",
+    );
+    assert!(msg.contains("key.toml") && msg.contains("colour"), "{msg}");
+    let msg = load_err("cam.toml", b"[[mesh]]\ngenerator = \"sphere\"\n[[camera]]\nname = \"c\"\neye = [0, 0, 0]\ntarget = [0, 0, 0]\n");
+    assert!(
+        msg.contains("camera 'c'") && msg.contains("target"),
+        "{msg}"
+    );
+    let msg = load_err("gen.toml", b"[[mesh]]\ngenerator = \"cube\"\n");
+    assert!(
+        msg.contains("unknown generator 'cube'") && msg.contains("teapots"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn unknown_scene_lists_the_builtins() {
+    let err =
+        continuum::scene::load_named_or_path("nope", &continuum_tests::scenes_dir()).unwrap_err();
+    assert!(matches!(err, SceneError::UnknownScene { .. }));
+    assert!(err.to_string().contains("bunny"), "{err}");
+}
+
+#[test]
+fn builtin_scenes_load_with_cameras_and_a_valid_bvh() {
+    let names = builtin_scenes();
+    for required in [
+        "teapots",
+        "bunny",
+        "box",
+        "orientation",
+        "grid",
+        "sphere",
+        "soup",
+    ] {
+        assert!(
+            names.iter().any(|n| n == required),
+            "built-in scene {required} missing from {names:?}"
+        );
+    }
+    for name in &names {
+        let p = prepared(name);
+        assert!(p.scene.cameras.len() >= 2, "{name}");
+        p.bvh.validate(&p.triangles, &p.drawable);
+    }
+    assert!(prepared("teapots").triangle_count() >= 1_000_000);
+    assert_eq!(prepared("bunny").triangle_count(), 69_451);
+    assert_eq!(prepared("orientation").triangle_count(), 524);
+}
+
+#[test]
+fn gltf_node_transforms_are_applied() {
+    // The Box sample's root node rotates +z into −y... its bounds stay the unit cube.
+    let b = prepared("box").bounds;
+    assert!(
+        (b.min.x + 0.5).abs() < 1e-6 && (b.max.y - 0.5).abs() < 1e-6,
+        "{b:?}"
+    );
+    // OrientationTest places arrows 5 units out along each axis.
+    let o = prepared("orientation").bounds;
+    assert!(
+        o.max.x > 5.0 && o.min.x < -5.0 && o.max.z > 5.0 && o.min.z < -5.0,
+        "{o:?}"
+    );
+}
+
+#[test]
+fn degenerate_triangles_load_but_are_never_drawn() {
+    use continuum::AlgorithmId;
+    use glam::Vec3;
+    let camera = continuum::Camera {
+        name: "c".into(),
+        eye: Vec3::new(0.0, 0.0, 3.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        fov_y_deg: 60.0,
+        near: None,
+    };
+    let positions = vec![
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+        Vec3::new(0.5, 0.5, 0.5),
+    ];
+    // Triangle 0 repeats a vertex, 1 is collinear, 2 is real.
+    let triangles = vec![[0, 0, 2], [0, 1, 1], [0, 1, 2]];
+    let scene: PreparedScene =
+        continuum_tests::scene_from_triangles(positions, triangles, camera.clone());
+    assert_eq!(scene.drawable, vec![2]);
+    for algorithm in AlgorithmId::ALL {
+        let out = continuum_tests::render_with(&scene, algorithm, &camera, 64, 64);
+        assert!(
+            out.framebuffer
+                .triangle_id
+                .iter()
+                .all(|&t| t == 2 || t == continuum::BACKGROUND)
+        );
+        assert!(out.framebuffer.triangle_id.contains(&2));
+    }
+}
