@@ -3,7 +3,7 @@
 //! It follows "3D Rasterization: A Bridge between Rasterization and Ray Casting"
 //! (Davidovič et al., GI 2012). Coverage is decided by edge functions — projected
 //! 2D ones, or the paper's 3D (Plücker) ones — and the algorithms differ only in
-//! how they enumerate triangles and samples. Every front end calls [`render`]:
+//! how they enumerate triangles and samples. Every front end calls [`render()`]:
 //!
 //! ```no_run
 //! use continuum::{render, AlgorithmId, PreparedScene, RenderRequest};

@@ -1,6 +1,6 @@
 //! Edge functions and the tie rule they share.
 //!
-//! - [`Edge3D`]/[`Triangle3D`]: the Plücker / signed-volume edge functions of paper
+//! - [`Triangle3D`]: the Plücker / signed-volume edge functions of paper
 //!   §3.2, evaluated per sample with no projection.
 //! - [`Triangle2D`]: projected 2D edge functions (paper §3.1).
 //!

@@ -2,7 +2,7 @@
 //! lights, and the loaders that build them (glTF, OBJ, TOML scene files, procedural
 //! generators).
 //!
-//! Every loader ends in [`validate::validate_mesh`]-style checks, so a `Scene` that
+//! Every loader ends in [`validate_part`] and [`Scene::validate`], so a `Scene` that
 //! exists has finite positions and in-range indices; degenerate triangles are kept
 //! (they load) but the renderer never draws them.
 
@@ -28,7 +28,7 @@ use crate::camera::Camera;
 
 /// Triangle geometry in world space, structure-of-arrays.
 ///
-/// Invariants (checked by [`Mesh::validate`]): every position is finite; every index
+/// Invariants (checked by [`Scene::validate`]): every position is finite; every index
 /// is `< positions.len()`; `material_ids.len() == triangles.len()`; `normals` and
 /// `uvs` are either empty or one per vertex.
 #[derive(Clone, Debug, Default)]
