@@ -238,13 +238,33 @@ pub fn glb(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
 
 /// A one-mesh `.glb` with the given positions and u16 indices (mode 4 unless `mode`).
 pub fn triangle_glb(positions: &[[f32; 3]], indices: &[u16], mode: u32) -> Vec<u8> {
+    let indices: Vec<u32> = indices.iter().map(|&i| u32::from(i)).collect();
+    let (json, bin) = triangle_gltf(positions, &indices, 5123, mode);
+    glb(&json, &bin)
+}
+
+/// The JSON and binary buffer of a one-mesh glTF: positions, then indices stored
+/// with `component_type` (5121 u8, 5123 u16, 5125 u32), primitive `mode`.
+pub fn triangle_gltf(
+    positions: &[[f32; 3]],
+    indices: &[u32],
+    component_type: u32,
+    mode: u32,
+) -> (serde_json::Value, Vec<u8>) {
     let mut bin: Vec<u8> = positions
         .iter()
         .flatten()
         .flat_map(|v| v.to_le_bytes())
         .collect();
     let pos_len = bin.len();
-    bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+    for &i in indices {
+        match component_type {
+            5121 => bin.push(i as u8),
+            5123 => bin.extend((i as u16).to_le_bytes()),
+            _ => bin.extend(i.to_le_bytes()),
+        }
+    }
+    let index_len = bin.len() - pos_len;
     let finite: Vec<[f32; 3]> = positions
         .iter()
         .copied()
@@ -270,12 +290,12 @@ pub fn triangle_glb(positions: &[[f32; 3]], indices: &[u16], mode: u32) -> Vec<u
         "buffers": [{ "byteLength": bin.len() }],
         "bufferViews": [
             { "buffer": 0, "byteOffset": 0, "byteLength": pos_len },
-            { "buffer": 0, "byteOffset": pos_len, "byteLength": indices.len() * 2 }
+            { "buffer": 0, "byteOffset": pos_len, "byteLength": index_len }
         ],
         "accessors": [
             { "bufferView": 0, "componentType": 5126, "count": positions.len(), "type": "VEC3", "min": min, "max": max },
-            { "bufferView": 1, "componentType": 5123, "count": indices.len(), "type": "SCALAR" }
+            { "bufferView": 1, "componentType": component_type, "count": indices.len(), "type": "SCALAR" }
         ]
     });
-    glb(&json, &bin)
+    (json, bin)
 }

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use continuum::PreparedScene;
 use continuum::scene::{SceneError, load_path};
-use continuum_tests::{builtin_scenes, prepared, triangle_glb};
+use continuum_tests::{builtin_scenes, glb, prepared, triangle_glb, triangle_gltf};
 
 fn temp_file(name: &str, bytes: &[u8]) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("continuum-loaders-{}", std::process::id()));
@@ -240,4 +240,49 @@ fn degenerate_triangles_load_but_are_never_drawn() {
         );
         assert!(out.framebuffer.triangle_id.contains(&2));
     }
+}
+
+#[test]
+fn every_index_width_loads() {
+    for component in [5121, 5123, 5125] {
+        let (json, bin) = triangle_gltf(&QUAD, &[0, 1, 2, 0, 2, 3], component, 4);
+        let path = temp_file(&format!("width{component}.glb"), &glb(&json, &bin));
+        let scene = load_path(&path).unwrap_or_else(|e| panic!("component type {component}: {e}"));
+        assert_eq!(scene.mesh.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+    }
+}
+
+#[test]
+fn gltf_cameras_lights_materials_and_transforms_load() {
+    let (mut json, bin) = triangle_gltf(&QUAD, &[0, 1, 2, 0, 2, 3], 5123, 4);
+    json["scenes"][0]["nodes"] = serde_json::json!([0, 1]);
+    json["nodes"] = serde_json::json!([
+        { "mesh": 0, "translation": [10.0, 0.0, 0.0], "children": [2] },
+        { "camera": 0, "name": "cam", "translation": [0.5, 0.5, 4.0] },
+        { "extensions": { "KHR_lights_punctual": { "light": 0 } }, "translation": [0.0, 3.0, 0.0] }
+    ]);
+    json["cameras"] = serde_json::json!([{ "name": "shot", "type": "perspective", "perspective": { "yfov": 0.5, "znear": 0.05, "aspectRatio": 1.5 } }]);
+    json["extensionsUsed"] = serde_json::json!(["KHR_lights_punctual"]);
+    json["extensions"] = serde_json::json!({ "KHR_lights_punctual": { "lights": [{ "type": "point", "color": [1.0, 0.5, 0.25], "intensity": 7.0 }] } });
+    json["materials"] = serde_json::json!([{ "name": "paint", "pbrMetallicRoughness": { "baseColorFactor": [0.1, 0.2, 0.3, 1.0] } }]);
+    json["meshes"][0]["primitives"][0]["material"] = serde_json::json!(0);
+    let path = temp_file("rich.glb", &glb(&json, &bin));
+    let scene = load_path(&path).expect("loads");
+    // The mesh node's translation moved the quad.
+    assert_eq!(scene.mesh.positions[0], glam::Vec3::new(10.0, 0.0, 0.0));
+    let camera = scene.camera("shot").expect("the glTF camera by name");
+    assert_eq!(camera.eye, glam::Vec3::new(0.5, 0.5, 4.0));
+    assert!((camera.fov_y_deg - 0.5f32.to_degrees()).abs() < 1e-4);
+    assert_eq!(camera.near, Some(0.05));
+    assert_eq!(scene.lights.len(), 1);
+    // The light's node is a child of the mesh node: it inherits the translation.
+    assert_eq!(
+        scene.lights[0].kind,
+        continuum::scene::LightKind::Point {
+            position: glam::Vec3::new(10.0, 3.0, 0.0)
+        }
+    );
+    assert_eq!(scene.lights[0].color, [1.0, 0.5, 0.25]);
+    assert_eq!(scene.materials[0].base_color, [0.1, 0.2, 0.3, 1.0]);
+    assert!(scene.mesh.material_ids.iter().all(|&m| m == 0));
 }
