@@ -30,7 +30,7 @@ pub struct SceneBvh {
 /// Pads a box by [`BOX_PAD`] of its largest coordinate magnitude (plus a tiny
 /// absolute amount for boxes at the origin).
 #[inline]
-fn padded(min: Vec3A, max: Vec3A) -> (Vec3A, Vec3A) {
+pub fn padded(min: Vec3A, max: Vec3A) -> (Vec3A, Vec3A) {
     let pad = min.abs().max(max.abs()).max_element() * BOX_PAD + f32::MIN_POSITIVE;
     (min - Vec3A::splat(pad), max + Vec3A::splat(pad))
 }
@@ -118,14 +118,14 @@ impl SceneBvh {
 
 /// A ray prepared for slab tests.
 #[derive(Clone, Copy, Debug)]
-struct SlabRay {
+pub struct SlabRay {
     origin: [f32; 3],
     dir: [f32; 3],
     inv: [f32; 3],
 }
 
 impl SlabRay {
-    fn new(origin: Vec3, dir: Vec3) -> SlabRay {
+    pub fn new(origin: Vec3, dir: Vec3) -> SlabRay {
         SlabRay {
             origin: origin.to_array(),
             dir: dir.to_array(),
@@ -135,7 +135,7 @@ impl SlabRay {
 
     /// Does the ray meet the box `[lo, hi]` at some `t ∈ [0, tmax]`?
     #[inline(always)]
-    fn hits(&self, lo: Vec3A, hi: Vec3A, tmax: f32) -> bool {
+    pub fn hits(&self, lo: Vec3A, hi: Vec3A, tmax: f32) -> bool {
         let (lo, hi) = (lo.to_array(), hi.to_array());
         let mut t0 = 0.0f32;
         let mut t1 = tmax;

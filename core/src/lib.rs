@@ -27,8 +27,9 @@ pub mod request;
 pub mod scene;
 pub mod shade;
 pub mod stats;
+pub mod traversal;
 
-pub use algorithm::{AlgorithmId, Family};
+pub use algorithm::{AlgorithmId, Family, Pipeline};
 pub use camera::{Camera, View};
 pub use framebuffer::{BACKGROUND, Framebuffer};
 pub use prepared::PreparedScene;

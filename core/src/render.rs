@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::algorithm::{AlgorithmId, render_2dr_brute, render_3dr_brute, render_raycast};
+use crate::algorithm::{self, AlgorithmId};
 use crate::camera::{Camera, CameraError, View};
 use crate::framebuffer::Framebuffer;
 use crate::prepared::PreparedScene;
@@ -19,6 +19,9 @@ pub const MAX_DIMENSION: u32 = 16384;
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderRequest {
     pub algorithm: AlgorithmId,
+    /// Explicit oracle settings on top of the algorithm's, in the CLI's words
+    /// (`outside=on,split=8,binning=off`); see [`crate::Pipeline::with_oracles`].
+    pub oracles: Option<String>,
     pub camera: Camera,
     pub width: u32,
     pub height: u32,
@@ -110,11 +113,14 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
     let mut fb = Framebuffer::new(request.width, request.height);
     let mut stats = Stats::default();
 
-    match request.algorithm {
-        AlgorithmId::TwoDBrute => render_2dr_brute(scene, &view, &mut fb, &mut stats),
-        AlgorithmId::ThreeDBrute => render_3dr_brute(scene, &view, &mut fb, &mut stats),
-        AlgorithmId::Raycast => render_raycast(scene, &view, &mut fb, &mut stats),
+    let mut pipeline = request.algorithm.pipeline();
+    if let Some(text) = &request.oracles {
+        pipeline = pipeline.with_oracles(text).map_err(|e| RenderError {
+            field: e.field,
+            message: e.message,
+        })?;
     }
+    algorithm::run(pipeline, scene, &view, &mut fb, &mut stats);
 
     let start = Instant::now();
     shade(scene, &view, &mut fb);
@@ -123,6 +129,9 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
     stats.edge_evaluations = fb.edge_evals.iter().map(|&e| u64::from(e)).sum();
     stats.max_edge_evals_per_pixel = fb.edge_evals.iter().copied().max().unwrap_or(0);
     stats.coverage_histogram = CoverageHistogram::of(&fb.coverage_writes);
+    let (setup_cost, sample_cost) = pipeline.instruction_costs();
+    stats.predicted_instructions =
+        stats.triangle_setups * setup_cost + stats.edge_evaluations * sample_cost;
     let hashes = Hashes::of(&fb);
     stats.time_ms.total = total.elapsed().as_secs_f64() * 1e3;
     Ok(RenderOutput {

@@ -14,12 +14,17 @@ pub struct RenderArgs {
     /// A built-in scene name, or a .toml, .gltf, .glb or .obj path.
     #[arg(long)]
     scene: String,
-    /// Algorithm id: 2dr-brute, 3dr-brute or raycast.
+    /// Algorithm id: 2dr-brute, 2dr-bin, 2dr-homogeneous, 3dr-brute, 3dr-bin,
+    /// 3dr-frustum-cull, 3dr-frustum-split, 3dr-full or raycast.
     #[arg(long, value_parser = |s: &str| parse_algorithm(s).map_err(|e| e.message))]
     algorithm: AlgorithmId,
     /// A camera of the scene (by name); default: the scene's first camera.
     #[arg(long)]
     camera: Option<String>,
+    /// Explicit oracle settings on top of the algorithm's, e.g.
+    /// outside=on,occluded=on,split=8,binning=on,early_z=off,frustum=256,leaf=8.
+    #[arg(long)]
+    oracles: Option<String>,
     /// Viewport: perspective (the camera's field of view) or perspective:FOV.
     #[arg(long, default_value = "perspective")]
     viewport: String,
@@ -66,6 +71,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let (width, height) = args.size;
     let request = RenderRequest {
         algorithm: args.algorithm,
+        oracles: args.oracles.clone(),
         camera,
         width,
         height,

@@ -25,6 +25,7 @@ pub struct RenderBody {
     pub scene: String,
     pub algorithm: String,
     pub camera: Option<CameraSpec>,
+    pub oracles: Option<String>,
     pub viewport: Option<String>,
     pub aa: Option<String>,
     pub size: Option<String>,
@@ -38,6 +39,7 @@ const OUTPUTS: [&str; 4] = ["color", "edge_evals", "depth", "triangle_id"];
 struct Checked {
     scene: String,
     algorithm: AlgorithmId,
+    oracles: Option<String>,
     camera: Option<CameraSpec>,
     fov_override: Option<f32>,
     size: (u32, u32),
@@ -88,9 +90,13 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
             ),
         ));
     }
+    if let Some(text) = &body.oracles {
+        algorithm.pipeline().with_oracles(text)?;
+    }
     Ok(Checked {
         scene: body.scene.clone(),
         algorithm,
+        oracles: body.oracles.clone(),
         camera: body.camera.clone(),
         fov_override,
         size,
@@ -114,6 +120,7 @@ async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, 
         }
         let request = RenderRequest {
             algorithm: c.algorithm,
+            oracles: c.oracles,
             camera,
             width: c.size.0,
             height: c.size.1,
@@ -166,6 +173,7 @@ pub struct RenderQuery {
     scene: String,
     algorithm: String,
     camera: Option<String>,
+    oracles: Option<String>,
     viewport: Option<String>,
     aa: Option<String>,
     size: Option<String>,
@@ -189,6 +197,7 @@ pub async fn render_png(
         scene: q.scene,
         algorithm: q.algorithm,
         camera: q.camera.map(CameraSpec::Named),
+        oracles: q.oracles,
         viewport: q.viewport,
         aa: q.aa,
         size: q.size,
@@ -236,6 +245,7 @@ pub async fn algorithms() -> Json<Value> {
                 "family": a.family(),
                 "description": a.description(),
                 "viewports": ["perspective"],
+                "takes_oracles": a.pipeline() != continuum::Pipeline::Rays,
                 "aa": ["none"],
             })
         })

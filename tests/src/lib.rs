@@ -42,16 +42,29 @@ pub fn render_with(
     width: u32,
     height: u32,
 ) -> RenderOutput {
+    render_with_oracles(scene, algorithm, None, camera, width, height)
+}
+
+/// As [`render_with`], with explicit oracle settings.
+pub fn render_with_oracles(
+    scene: &PreparedScene,
+    algorithm: AlgorithmId,
+    oracles: Option<&str>,
+    camera: &Camera,
+    width: u32,
+    height: u32,
+) -> RenderOutput {
     render(
         scene,
         &RenderRequest {
             algorithm,
+            oracles: oracles.map(str::to_string),
             camera: camera.clone(),
             width,
             height,
         },
     )
-    .unwrap_or_else(|e| panic!("{algorithm}: {e}"))
+    .unwrap_or_else(|e| panic!("{algorithm} {oracles:?}: {e}"))
 }
 
 /// Pixels where two triangle-id buffers differ, as `(x, y, a, b)`.

@@ -9,7 +9,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::camera::{View, pixel_center};
-use crate::edge::Triangle3D;
+use crate::edge::{Coverage, Triangle3D};
 use crate::framebuffer::{BACKGROUND, Framebuffer};
 use crate::prepared::PreparedScene;
 use crate::stats::Stats;
@@ -40,7 +40,6 @@ pub(crate) fn render_raycast(
 
     // 2. One ray per pixel, bands of rows in parallel.
     let start = Instant::now();
-    let near = view.near;
     let nodes: u64 = fb
         .bands_mut(BAND_ROWS)
         .into_par_iter()
@@ -55,7 +54,7 @@ pub(crate) fn render_raycast(
                     nodes += scene.bvh.walk(view.eye, view.direction(xc, yc), |k| {
                         if let Some(tri) = &setups[k as usize] {
                             evals += 1;
-                            if let Some(w) = tri.sample(xc, yc, near) {
+                            if let Some(w) = tri.sample(xc, yc) {
                                 covered += 1;
                                 let id = scene.drawable[k as usize];
                                 if w < best_w || (w == best_w && id < best_id) {

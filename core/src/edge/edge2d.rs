@@ -6,7 +6,7 @@
 //! apply opposite signs, so a sample on the edge goes to exactly one of them; a
 //! sample exactly on a vertex gets `E = 0` exactly on both of its edges.
 
-use super::{inside_edge, owns_tie};
+use super::{Coverage, owns_tie};
 
 /// A projected vertex: pixel coordinates and `1/w` for perspective-correct depth.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -28,6 +28,10 @@ pub struct Triangle2D {
     pub owns: [bool; 3],
     /// `1/w` at each vertex.
     inv_w: [f32; 3],
+    /// Smallest and largest vertex `w`: sample depths are clamped into it.
+    w_range: [f32; 2],
+    /// Per edge, a bound on the rounding error of an evaluation on the image.
+    error: [f32; 3],
     /// Pixel-coordinate bounds of the vertices: `[min_x, min_y, max_x, max_y]`.
     pub bounds: [f32; 4],
 }
@@ -35,13 +39,16 @@ pub struct Triangle2D {
 impl Triangle2D {
     /// Sets up the three edge functions; `None` for triangles that are degenerate
     /// in f32 after projection (some vertex not strictly inside its opposite edge).
-    pub fn setup(v: &[ScreenVertex; 3]) -> Option<Triangle2D> {
+    pub fn setup(v: &[ScreenVertex; 3], width: u32, height: u32) -> Option<Triangle2D> {
+        let w = v.map(|s| 1.0 / s.inv_w);
         let mut t = Triangle2D {
             lo: [[0.0; 2]; 3],
             delta: [[0.0; 2]; 3],
             sign: [1.0; 3],
             owns: [false; 3],
             inv_w: [v[0].inv_w, v[1].inv_w, v[2].inv_w],
+            w_range: [w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2])],
+            error: [0.0; 3],
             bounds: [
                 v[0].x.min(v[1].x).min(v[2].x),
                 v[0].y.min(v[1].y).min(v[2].y),
@@ -77,6 +84,12 @@ impl Triangle2D {
             }
             // ∂E/∂x = −Δy·s, ∂E/∂y = Δx·s.
             t.owns[i] = owns_tie(-t.delta[i][1] * t.sign[i], t.delta[i][0] * t.sign[i]);
+            // Δx·(y − ly) − Δy·(x − lx) rounds five times, each by at most 2⁻²⁴ of
+            // the terms' magnitudes; 2⁻²⁰ leaves a margin.
+            let [lx, ly] = t.lo[i];
+            let [dx, dy] = t.delta[i];
+            let span = dx.abs() * (height as f32 + ly.abs()) + dy.abs() * (width as f32 + lx.abs());
+            t.error[i] = span * (1.0 / (1 << 20) as f32);
         }
         Some(t)
     }
@@ -88,10 +101,12 @@ impl Triangle2D {
         let [dx, dy] = self.delta[i];
         dx * (y - ly) - dy * (x - lx)
     }
+}
 
+impl Coverage for Triangle2D {
     /// The three signed edge values at pixel point `(x, y)`.
     #[inline(always)]
-    pub fn edge_values(&self, x: f32, y: f32) -> [f32; 3] {
+    fn edge_values(&self, x: f32, y: f32) -> [f32; 3] {
         [
             self.raw(0, x, y) * self.sign[0],
             self.raw(1, x, y) * self.sign[1],
@@ -99,20 +114,26 @@ impl Triangle2D {
         ]
     }
 
-    /// Coverage and perspective-correct depth at `(x, y)`: `Some(w)` with
-    /// `1/w = Σ λ_i / w_i`, `λ_i = E_i / ΣE` (paper §3.1).
     #[inline(always)]
-    pub fn sample(&self, x: f32, y: f32) -> Option<f32> {
-        let e = self.edge_values(x, y);
-        if !(inside_edge(e[0], self.owns[0])
-            && inside_edge(e[1], self.owns[1])
-            && inside_edge(e[2], self.owns[2]))
-        {
-            return None;
-        }
+    fn owns(&self) -> [bool; 3] {
+        self.owns
+    }
+
+    /// Perspective-correct depth: `1/w = Σ λ_i / w_i`, `λ_i = E_i / ΣE` (paper
+    /// §3.1), clamped to the vertices' range.
+    #[inline(always)]
+    fn depth(&self, e: [f32; 3], _x: f32, _y: f32) -> Option<f32> {
         let sum = e[0] + e[1] + e[2];
         let inv_w = e[0] * self.inv_w[0] + e[1] * self.inv_w[1] + e[2] * self.inv_w[2];
         let w = sum / inv_w;
-        (w > 0.0 && w < f32::INFINITY).then_some(w)
+        (w > 0.0 && w < f32::INFINITY).then(|| w.clamp(self.w_range[0], self.w_range[1]))
+    }
+
+    fn edge_error(&self) -> [f32; 3] {
+        self.error
+    }
+
+    fn min_depth(&self) -> f32 {
+        self.w_range[0]
     }
 }

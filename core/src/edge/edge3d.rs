@@ -8,7 +8,7 @@
 
 use glam::Vec3;
 
-use super::{inside_edge, owns_tie};
+use super::{Coverage, owns_tie};
 use crate::camera::View;
 
 /// A triangle set up for 3D rasterization against one view: per edge `i`
@@ -23,7 +23,7 @@ use crate::camera::View;
 /// terms ~10⁵× larger): on 1M-triangle scenes that gave `w` errors of 0.1%.
 ///
 /// Every algorithm of the 3D family and the ray caster decide coverage and depth
-/// through [`Triangle3D::sample`] on these coefficients, in one fixed operation
+/// through [`Coverage::sample`] on these coefficients, in one fixed operation
 /// order with no fused multiply-add, so they agree bit for bit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Triangle3D {
@@ -36,6 +36,15 @@ pub struct Triangle3D {
     pub nd: [f32; 3],
     /// Per edge: does it own samples exactly on it (the §3.4 tie rule)?
     pub owns: [bool; 3],
+    /// View-axis distance of the nearest and farthest vertex: every sample's `w`
+    /// is clamped into this range (exact in real arithmetic, and it gives early-z
+    /// and occlusion culling a bound no rounding can undercut).
+    pub w_range: [f32; 2],
+    /// Samples nearer than this are rejected.
+    pub near: f32,
+    /// Per edge: a bound on the rounding error of [`Coverage::edge_values`] anywhere
+    /// on the image (for conservative binning).
+    pub error: [f32; 3],
 }
 
 /// The midpoint edge normal `(e − (a+b)/2) × (a − b)` of §3.4. Swapping `a` and `b`
@@ -73,13 +82,23 @@ impl Triangle3D {
                 sign * normal.dot(view.dy),
             ],
             owns: [false; 3],
+            w_range: [0.0; 2],
+            near: view.near,
+            error: [0.0; 3],
         };
+        let w = p.map(|v| (v - eye).dot(view.forward));
+        t.w_range = [w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2])];
+        let (x_max, y_max) = (view.width as f32, view.height as f32);
         for i in 0..3 {
             let n = edge_normal(eye, p[(i + 1) % 3], p[(i + 2) % 3]) * sign;
             t.a[i] = n.dot(view.d0);
             t.b[i] = n.dot(view.dx);
             t.c[i] = n.dot(view.dy);
             t.owns[i] = owns_tie(t.b[i], t.c[i]);
+            // (A + x·B) + y·C rounds four times, each by at most 2⁻²⁴ of the sum of
+            // the terms' magnitudes; 2⁻²⁰ leaves a factor-4 margin.
+            t.error[i] = (t.a[i].abs() + x_max * t.b[i].abs() + y_max * t.c[i].abs())
+                * (1.0 / (1 << 20) as f32);
         }
         if !(t
             .a
@@ -93,10 +112,12 @@ impl Triangle3D {
         }
         Some(t)
     }
+}
 
+impl Coverage for Triangle3D {
     /// The three edge values at image point `(x, y)`: `(A + x·B) + y·C`.
     #[inline(always)]
-    pub fn edge_values(&self, x: f32, y: f32) -> [f32; 3] {
+    fn edge_values(&self, x: f32, y: f32) -> [f32; 3] {
         [
             self.a[0] + x * self.b[0] + y * self.c[0],
             self.a[1] + x * self.b[1] + y * self.c[1],
@@ -104,22 +125,27 @@ impl Triangle3D {
         ]
     }
 
-    /// Coverage and depth of the sample at `(x, y)`: `Some(w)` when all three edges
-    /// contain it (ties by [`owns_tie`]) and `w = |D| / (N·d) ≥ near`.
     #[inline(always)]
-    pub fn sample(&self, x: f32, y: f32, near: f32) -> Option<f32> {
-        let e = self.edge_values(x, y);
-        if !(inside_edge(e[0], self.owns[0])
-            && inside_edge(e[1], self.owns[1])
-            && inside_edge(e[2], self.owns[2]))
-        {
-            return None;
-        }
+    fn owns(&self) -> [bool; 3] {
+        self.owns
+    }
+
+    /// `w = |D| / (N·d)`, clamped to the vertices' range; `None` below `near`.
+    #[inline(always)]
+    fn depth(&self, _edges: [f32; 3], x: f32, y: f32) -> Option<f32> {
         let facing = self.nd[0] + x * self.nd[1] + y * self.nd[2];
         if facing <= 0.0 {
             return None;
         }
-        let w = self.volume / facing;
-        (w >= near && w < f32::INFINITY).then_some(w)
+        let w = (self.volume / facing).clamp(self.w_range[0], self.w_range[1]);
+        (w >= self.near).then_some(w)
+    }
+
+    fn edge_error(&self) -> [f32; 3] {
+        self.error
+    }
+
+    fn min_depth(&self) -> f32 {
+        self.w_range[0].max(self.near)
     }
 }

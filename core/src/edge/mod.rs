@@ -9,9 +9,11 @@
 
 mod edge2d;
 mod edge3d;
+mod homogeneous;
 
 pub use edge2d::{ScreenVertex, Triangle2D};
 pub use edge3d::Triangle3D;
+pub use homogeneous::TriangleHomogeneous;
 
 /// The tie rule of paper §3.4 (Direct3D's top-left rule written with derivatives):
 /// a sample on an edge (`E = 0`) belongs to the triangle whose edge function grows
@@ -28,4 +30,39 @@ pub fn owns_tie(de_dx: f32, de_dy: f32) -> bool {
 #[inline(always)]
 pub fn inside_edge(e: f32, owns: bool) -> bool {
     e > 0.0 || (e == 0.0 && owns)
+}
+
+/// A triangle set up for one view, as every coverage loop sees it. `sample` is
+/// the single decision all algorithms of a family share: edge values in one fixed
+/// operation order, the tie rule, then depth.
+pub trait Coverage {
+    /// The three edge values at image point `(x, y)`, positive inside.
+    fn edge_values(&self, x: f32, y: f32) -> [f32; 3];
+
+    /// Per edge: does it own samples exactly on it?
+    fn owns(&self) -> [bool; 3];
+
+    /// Depth `w` of the sample at `(x, y)` with edge values `edges`, or `None`
+    /// when the sample is rejected (nearer than `near`, or not in front).
+    fn depth(&self, edges: [f32; 3], x: f32, y: f32) -> Option<f32>;
+
+    /// Per edge, a bound on how far two evaluations of [`Coverage::edge_values`]
+    /// at points of the image can be off their exact values; binning rejects or
+    /// accepts a block only beyond it.
+    fn edge_error(&self) -> [f32; 3];
+
+    /// No sample of the triangle has a smaller depth than this.
+    fn min_depth(&self) -> f32;
+
+    /// Coverage and depth of the sample at `(x, y)`.
+    #[inline(always)]
+    fn sample(&self, x: f32, y: f32) -> Option<f32> {
+        let e = self.edge_values(x, y);
+        let o = self.owns();
+        if inside_edge(e[0], o[0]) && inside_edge(e[1], o[1]) && inside_edge(e[2], o[2]) {
+            self.depth(e, x, y)
+        } else {
+            None
+        }
+    }
 }

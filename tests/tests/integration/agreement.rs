@@ -1,7 +1,7 @@
 //! Algorithms agree: the 3D family (3dr-brute, raycast) bit for bit; the 2D family
 //! against the 3D family with every differing pixel explained.
 
-use continuum::AlgorithmId;
+use continuum::{AlgorithmId, Family, RenderOutput};
 use continuum_tests::{
     DifferenceReport, builtin_scenes, explain_2d_3d, id_differences, prepared, render_with,
 };
@@ -9,8 +9,38 @@ use continuum_tests::{
 const W: u32 = 640;
 const H: u32 = 480;
 
+/// Every algorithm of `family`.
+fn members(family: Family) -> Vec<AlgorithmId> {
+    AlgorithmId::ALL
+        .into_iter()
+        .filter(|a| a.family() == family)
+        .collect()
+}
+
+fn assert_same_buffers(name: &str, camera: &str, a: &RenderOutput, b: &RenderOutput) {
+    let diff = id_differences(a, b);
+    assert!(
+        diff.is_empty(),
+        "{name}/{camera}: {} and {} differ at {} pixels, first {:?}",
+        a.algorithm,
+        b.algorithm,
+        diff.len(),
+        &diff[..diff.len().min(8)]
+    );
+    assert_eq!(
+        a.framebuffer.depth, b.framebuffer.depth,
+        "{name}/{camera}: {} vs {} depth",
+        a.algorithm, b.algorithm
+    );
+    assert_eq!(
+        a.hashes, b.hashes,
+        "{name}/{camera}: {} vs {}",
+        a.algorithm, b.algorithm
+    );
+}
+
 #[test]
-fn three_d_family_is_bitwise_identical_on_every_builtin_scene_and_camera() {
+fn each_family_is_bitwise_identical_on_every_builtin_scene_and_camera() {
     let mut checked = 0;
     for name in builtin_scenes() {
         let scene = prepared(&name);
@@ -24,26 +54,18 @@ fn three_d_family_is_bitwise_identical_on_every_builtin_scene_and_camera() {
             "{name} needs a camera inside the geometry, with triangles through its eye plane"
         );
         for camera in &scene.scene.cameras {
-            let brute = render_with(&scene, AlgorithmId::ThreeDBrute, camera, W, H);
-            let ray = render_with(&scene, AlgorithmId::Raycast, camera, W, H);
-            let diff = id_differences(&brute, &ray);
-            assert!(
-                diff.is_empty(),
-                "{name}/{}: {} pixels differ, first {:?}",
-                camera.name,
-                diff.len(),
-                &diff[..diff.len().min(8)]
-            );
-            assert_eq!(
-                brute.framebuffer.depth, ray.framebuffer.depth,
-                "{name}/{}",
-                camera.name
-            );
-            assert_eq!(brute.hashes, ray.hashes, "{name}/{}", camera.name);
-            checked += 1;
+            for family in [Family::ThreeD, Family::TwoD] {
+                let algorithms = members(family);
+                let reference = render_with(&scene, algorithms[0], camera, W, H);
+                for &other in &algorithms[1..] {
+                    let out = render_with(&scene, other, camera, W, H);
+                    assert_same_buffers(&name, &camera.name, &reference, &out);
+                    checked += 1;
+                }
+            }
         }
     }
-    assert!(checked >= 14, "only {checked} scene cameras checked");
+    assert!(checked >= 14 * 6, "only {checked} comparisons");
 }
 
 /// How many drawable triangles have vertices on both sides of the camera's eye plane.
@@ -68,11 +90,21 @@ fn check_2d_against_3d(
     scene: &continuum::PreparedScene,
     camera: &continuum::Camera,
 ) -> DifferenceReport {
-    let two = render_with(scene, AlgorithmId::TwoDBrute, camera, W, H);
+    check_against_3d(name, scene, camera, AlgorithmId::TwoDBrute)
+}
+
+/// Checks `algorithm` (of another family) against `3dr-brute`.
+fn check_against_3d(
+    name: &str,
+    scene: &continuum::PreparedScene,
+    camera: &continuum::Camera,
+    algorithm: AlgorithmId,
+) -> DifferenceReport {
+    let two = render_with(scene, algorithm, camera, W, H);
     let three = render_with(scene, AlgorithmId::ThreeDBrute, camera, W, H);
     let r = explain_2d_3d(scene, &two, &three);
     println!(
-        "{name}/{}: {} covered, differing: {} at edges, {} at the near plane, {} depth ties, {} unexplained",
+        "{name}/{} {algorithm}: {} covered, differing: {} at edges, {} at the near plane, {} depth ties, {} unexplained",
         camera.name,
         r.covered,
         r.edge,
@@ -101,11 +133,20 @@ fn check_2d_against_3d(
 
 #[test]
 fn two_d_family_differs_from_three_d_only_where_explained() {
+    other_family_differs_from_three_d_only_where_explained(AlgorithmId::TwoDBrute);
+}
+
+#[test]
+fn homogeneous_family_differs_from_three_d_only_where_explained() {
+    other_family_differs_from_three_d_only_where_explained(AlgorithmId::TwoDHomogeneous);
+}
+
+fn other_family_differs_from_three_d_only_where_explained(algorithm: AlgorithmId) {
     let mut total = DifferenceReport::default();
     for name in builtin_scenes() {
         let scene = prepared(&name);
         for camera in &scene.scene.cameras {
-            let r = check_2d_against_3d(&name, &scene, camera);
+            let r = check_against_3d(&name, &scene, camera, algorithm);
             total.covered += r.covered;
             total.edge += r.edge;
             total.near_plane += r.near_plane;
@@ -113,7 +154,7 @@ fn two_d_family_differs_from_three_d_only_where_explained() {
         }
     }
     println!(
-        "all scenes: {} covered pixels, {} differ ({} edge, {} near plane, {} depth tie)",
+        "{algorithm}, all scenes: {} covered pixels, {} differ ({} edge, {} near plane, {} depth tie)",
         total.covered,
         total.explained(),
         total.edge,
@@ -156,8 +197,16 @@ fn every_algorithm_discards_what_lies_nearer_than_near() {
         ids.push(out);
     }
     check_2d_against_3d("grid", &scene, &camera);
-    assert!(
-        id_differences(&ids[1], &ids[2]).is_empty(),
-        "3dr-brute and raycast differ"
-    );
+    for out in &ids {
+        let first = ids
+            .iter()
+            .find(|o| o.algorithm.family() == out.algorithm.family())
+            .expect("itself");
+        assert!(
+            id_differences(first, out).is_empty(),
+            "{} differs from {}",
+            out.algorithm,
+            first.algorithm
+        );
+    }
 }

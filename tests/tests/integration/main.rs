@@ -2,5 +2,6 @@
 
 mod agreement;
 mod loaders;
+mod oracles;
 mod tie_rules;
 mod watertight;

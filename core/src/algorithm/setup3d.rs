@@ -1,69 +1,53 @@
-//! `3dr-brute`: every triangle set up with 3D edge functions (paper §3.2) and
-//! tested at every pixel of its screen bounding box. No projection and no clipping
-//! decide coverage; the box only bounds the search.
-
-use std::time::Instant;
+//! Setup of the 3D family (paper §3.2) and of homogeneous 2D rasterization: edge
+//! functions with no projection and no clipping; a conservative screen box only
+//! bounds the search.
 
 use glam::Vec3;
 use rayon::prelude::*;
 
 use super::PixelRect;
-use super::bands::{BoxedTriangle, rasterize_boxes};
+use super::tiles::Placed;
 use crate::camera::View;
 use crate::clip::{ClipPlane, clip_triangle};
-use crate::edge::Triangle3D;
-use crate::framebuffer::Framebuffer;
+use crate::edge::{Triangle3D, TriangleHomogeneous};
 use crate::prepared::PreparedScene;
-use crate::stats::Stats;
 
-struct Boxed3D {
-    tri: Triangle3D,
-    rect: PixelRect,
-    id: u32,
-    near: f32,
-}
-
-impl BoxedTriangle for Boxed3D {
-    fn rect(&self) -> PixelRect {
-        self.rect
-    }
-    fn id(&self) -> u32 {
-        self.id
-    }
-    #[inline(always)]
-    fn sample(&self, x: f32, y: f32) -> Option<f32> {
-        self.tri.sample(x, y, self.near)
-    }
-}
-
-pub(crate) fn render_3dr_brute(
-    scene: &PreparedScene,
-    view: &View,
-    fb: &mut Framebuffer,
-    stats: &mut Stats,
-) {
-    let start = Instant::now();
-    let items: Vec<Boxed3D> = scene
+/// Every drawable triangle with samples on screen, set up with 3D edge functions.
+pub(crate) fn setup_3d(scene: &PreparedScene, view: &View) -> Vec<Placed<Triangle3D>> {
+    scene
         .drawable
         .par_iter()
         .filter_map(|&id| {
             let p = &scene.triangles[id as usize];
             let rect = screen_rect(p, view)?;
-            let tri = Triangle3D::setup(p, view)?;
-            Some(Boxed3D {
-                tri,
+            Some(Placed {
+                tri: Triangle3D::setup(p, view)?,
                 rect,
                 id,
-                near: view.near,
             })
         })
-        .collect();
-    stats.triangle_setups = items.len() as u64;
-    stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
+        .collect()
+}
 
-    let start = Instant::now();
-    rasterize_boxes(&items, fb);
-    stats.time_ms.coverage = start.elapsed().as_secs_f64() * 1e3;
+/// Every drawable triangle with samples on screen, set up for homogeneous 2D
+/// rasterization (no clipping).
+pub(crate) fn setup_homogeneous(
+    scene: &PreparedScene,
+    view: &View,
+) -> Vec<Placed<TriangleHomogeneous>> {
+    scene
+        .drawable
+        .par_iter()
+        .filter_map(|&id| {
+            let p = &scene.triangles[id as usize];
+            let rect = screen_rect(p, view)?;
+            Some(Placed {
+                tri: TriangleHomogeneous::setup(p, view)?,
+                rect,
+                id,
+            })
+        })
+        .collect()
 }
 
 /// A conservative screen box for the part of the triangle at `w ≥ near`: the

@@ -1,49 +1,21 @@
-//! `2dr-brute`: the classic pipeline (paper §3.1). Transform to camera space, clip
-//! against the near plane and a guard band (Sutherland–Hodgman), project, set up
-//! 2D edge functions and test every pixel of the bounding box, with the top-left
-//! rule and a perspective-correct w-buffer.
-
-use std::time::Instant;
+//! Setup of the 2D family (paper §3.1): transform to camera space, clip against
+//! the near plane and a guard band (Sutherland–Hodgman), project, set up 2D edge
+//! functions (top-left rule, perspective-correct w) per piece of the clipped polygon.
 
 use rayon::prelude::*;
 
 use super::PixelRect;
-use super::bands::{BoxedTriangle, rasterize_boxes};
+use super::tiles::Placed;
 use crate::camera::View;
 use crate::clip::{clip_triangle, pipeline_planes};
 use crate::edge::{ScreenVertex, Triangle2D};
-use crate::framebuffer::Framebuffer;
 use crate::prepared::PreparedScene;
-use crate::stats::Stats;
 
-struct Boxed2D {
-    tri: Triangle2D,
-    rect: PixelRect,
-    id: u32,
-}
-
-impl BoxedTriangle for Boxed2D {
-    fn rect(&self) -> PixelRect {
-        self.rect
-    }
-    fn id(&self) -> u32 {
-        self.id
-    }
-    #[inline(always)]
-    fn sample(&self, x: f32, y: f32) -> Option<f32> {
-        self.tri.sample(x, y)
-    }
-}
-
-pub(crate) fn render_2dr_brute(
-    scene: &PreparedScene,
-    view: &View,
-    fb: &mut Framebuffer,
-    stats: &mut Stats,
-) {
-    let start = Instant::now();
+/// Every drawable triangle, clipped, projected and set up; pieces without
+/// samples on screen are dropped.
+pub(crate) fn setup_2d(scene: &PreparedScene, view: &View) -> Vec<Placed<Triangle2D>> {
     let planes = pipeline_planes(view.near, view.tan_half_x, view.tan_half_y);
-    let items: Vec<Boxed2D> = scene
+    scene
         .drawable
         .par_iter()
         .fold(Vec::new, |mut out, &id| {
@@ -73,13 +45,17 @@ pub(crate) fn render_2dr_brute(
             }
             // 3. Fan-triangulate and set up each piece.
             for k in 1..poly.len - 1 {
-                let Some(tri) = Triangle2D::setup(&[screen[0], screen[k], screen[k + 1]]) else {
+                let Some(tri) = Triangle2D::setup(
+                    &[screen[0], screen[k], screen[k + 1]],
+                    view.width,
+                    view.height,
+                ) else {
                     continue;
                 };
                 let [x0, y0, x1, y1] = tri.bounds;
                 if let Some(rect) = PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height)
                 {
-                    out.push(Boxed2D { tri, rect, id });
+                    out.push(Placed { tri, rect, id });
                 }
             }
             out
@@ -87,11 +63,5 @@ pub(crate) fn render_2dr_brute(
         .reduce(Vec::new, |mut a, mut b| {
             a.append(&mut b);
             a
-        });
-    stats.triangle_setups = items.len() as u64;
-    stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
-
-    let start = Instant::now();
-    rasterize_boxes(&items, fb);
-    stats.time_ms.coverage = start.elapsed().as_secs_f64() * 1e3;
+        })
 }

@@ -1,0 +1,86 @@
+//! Screen tiles: triangles are sorted into square tiles of the image by their
+//! bounding boxes (a counting sort), and the tiles are rendered in parallel,
+//! each into its own [`TileBuffer`].
+
+use rayon::prelude::*;
+
+use super::PixelRect;
+use super::kernel::{SampleOracles, raster_triangle};
+use crate::edge::Coverage;
+use crate::framebuffer::{Framebuffer, TileBuffer};
+use crate::stats::RasterCounters;
+
+/// Side of a screen tile in pixels.
+pub(crate) const TILE: u32 = 64;
+
+/// A set-up triangle with its screen box and id.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Placed<T> {
+    pub tri: T,
+    pub rect: PixelRect,
+    pub id: u32,
+}
+
+/// Renders `items` into `fb`, tile by tile in parallel.
+pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
+    items: &[Placed<T>],
+    fb: &mut Framebuffer,
+    oracles: SampleOracles,
+) -> RasterCounters {
+    let columns = fb.width.div_ceil(TILE) as usize;
+    let rows = fb.height.div_ceil(TILE) as usize;
+    let tile_count = columns * rows;
+    let tiles_of = |r: &PixelRect| {
+        let (tx0, tx1) = (r.x0 / TILE, r.x1 / TILE);
+        let (ty0, ty1) = (r.y0 / TILE, r.y1 / TILE);
+        (ty0..=ty1)
+            .flat_map(move |ty| (tx0..=tx1).map(move |tx| ty as usize * columns + tx as usize))
+    };
+
+    // 1. Counting sort of item indices by tile.
+    let mut offsets = vec![0u32; tile_count + 1];
+    for item in items {
+        for t in tiles_of(&item.rect) {
+            offsets[t + 1] += 1;
+        }
+    }
+    for t in 0..tile_count {
+        offsets[t + 1] += offsets[t];
+    }
+    let mut fill = offsets.clone();
+    let mut members = vec![0u32; offsets[tile_count] as usize];
+    for (k, item) in items.iter().enumerate() {
+        for t in tiles_of(&item.rect) {
+            members[fill[t] as usize] = k as u32;
+            fill[t] += 1;
+        }
+    }
+
+    // 2. Tiles in parallel, in input order within a tile.
+    let rects = fb.tile_rects(TILE);
+    let done: Vec<(TileBuffer, RasterCounters)> = rects
+        .par_iter()
+        .enumerate()
+        .map(|(t, &(x0, y0, x1, y1))| {
+            let mut tile = TileBuffer::new(x0, y0, x1, y1);
+            let mut counters = RasterCounters::default();
+            for &k in &members[offsets[t] as usize..offsets[t + 1] as usize] {
+                let item = &items[k as usize];
+                let clip = PixelRect {
+                    x0: item.rect.x0.max(x0),
+                    y0: item.rect.y0.max(y0),
+                    x1: item.rect.x1.min(x1 - 1),
+                    y1: item.rect.y1.min(y1 - 1),
+                };
+                raster_triangle(&mut tile, &item.tri, item.id, clip, oracles, &mut counters);
+            }
+            (tile, counters)
+        })
+        .collect();
+    let mut total = RasterCounters::default();
+    for (tile, counters) in &done {
+        fb.store(tile);
+        total += *counters;
+    }
+    total
+}

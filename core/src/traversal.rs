@@ -1,0 +1,287 @@
+//! The continuum's one algorithm (paper Fig. 7): a recursive traversal of frusta
+//! over screen regions through the BVH, steered by oracles.
+//!
+//! ```text
+//! traverse(frustum F, node N):
+//!   if is_occluded(F, N) or is_outside(F, N): return        // Fig. 6a
+//!   if split_frustum(F, N): for Fi in split(F): traverse(Fi, N)  // Fig. 6b, c
+//!   else if N is a leaf: rasterize(N, binning)               // Fig. 6d
+//!   else: for child C of N, front to back: traverse(F, C)
+//! ```
+//! Every test is conservative — a node is culled only when none of its triangles
+//! can win a sample of the frustum — so every setting of the oracles renders the
+//! same image as `3dr-brute`.
+
+use glam::{Vec3, Vec3A};
+
+use crate::algorithm::PixelRect;
+use crate::algorithm::kernel::{SampleOracles, raster_triangle};
+use crate::algorithm::setup3d::screen_rect;
+use crate::bvh::{SlabRay, padded};
+use crate::camera::View;
+use crate::edge::Triangle3D;
+use crate::framebuffer::TileBuffer;
+use crate::prepared::PreparedScene;
+use crate::stats::RasterCounters;
+
+/// The oracles of Fig. 7 for a BVH traversal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TraversalOracles {
+    /// Side of the initial frusta in pixels (each is one parallel work item).
+    pub frustum: u32,
+    /// `is_outside`: cull nodes outside the frustum.
+    pub outside: bool,
+    /// `is_occluded`: cull nodes behind the hierarchical w-buffer.
+    pub occluded: bool,
+    /// `split_frustum`: split down to this many pixels square (`None`: never).
+    pub split: Option<u32>,
+    /// `generate_samples` at leaves: how samples are enumerated.
+    pub samples: SampleOracles,
+}
+
+/// Per-frustum traversal state and counters.
+pub(crate) struct Traversal<'a> {
+    pub scene: &'a PreparedScene,
+    pub view: &'a View,
+    pub oracles: TraversalOracles,
+    pub tile: TileBuffer,
+    pub counters: RasterCounters,
+    pub nodes_visited: u64,
+    pub setups: u64,
+}
+
+/// A node of the CWBVH: an inner node (index) or a leaf (primitive range).
+#[derive(Clone, Copy, Debug)]
+enum NodeRef {
+    Inner(u32),
+    Leaf { start: u32, count: u32 },
+}
+
+/// A box with its nearest view-axis distance.
+#[derive(Clone, Copy, Debug)]
+struct NodeBox {
+    lo: Vec3A,
+    hi: Vec3A,
+    min_w: f32,
+}
+
+impl<'a> Traversal<'a> {
+    pub fn new(
+        scene: &'a PreparedScene,
+        view: &'a View,
+        oracles: TraversalOracles,
+        rect: (u32, u32, u32, u32),
+    ) -> Self {
+        Traversal {
+            scene,
+            view,
+            oracles,
+            tile: TileBuffer::new(rect.0, rect.1, rect.2, rect.3),
+            counters: RasterCounters::default(),
+            nodes_visited: 0,
+            setups: 0,
+        }
+    }
+
+    /// Traverses the whole tile from the BVH root.
+    pub fn run(&mut self) {
+        let bvh = &self.scene.bvh.cwbvh;
+        if bvh.nodes.is_empty() {
+            return;
+        }
+        let root = self.node_box(bvh.total_aabb.min, bvh.total_aabb.max);
+        let t = &self.tile;
+        let f = PixelRect {
+            x0: t.x0,
+            y0: t.y0,
+            x1: t.x1 - 1,
+            y1: t.y1 - 1,
+        };
+        self.counters.frusta_created += 1;
+        self.traverse(f, NodeRef::Inner(0), root);
+    }
+
+    fn node_box(&self, min: Vec3A, max: Vec3A) -> NodeBox {
+        let (lo, hi) = padded(min, max);
+        // Nearest w over the box: the corner furthest against the view axis.
+        let f = Vec3A::from(self.view.forward);
+        let corner = Vec3A::select(f.cmpge(Vec3A::ZERO), lo, hi);
+        NodeBox {
+            lo,
+            hi,
+            min_w: (corner - Vec3A::from(self.view.eye)).dot(f),
+        }
+    }
+
+    /// Fig. 7.
+    fn traverse(&mut self, f: PixelRect, node: NodeRef, b: NodeBox) {
+        self.nodes_visited += 1;
+        // 1. is_outside / is_occluded (Fig. 6a).
+        if self.oracles.outside && self.is_outside(f, &b) {
+            self.counters.nodes_culled_outside += 1;
+            return;
+        }
+        if self.oracles.occluded && b.min_w > self.tile.hiz_max(f.x0, f.y0, f.x1, f.y1) {
+            self.counters.nodes_culled_occluded += 1;
+            return;
+        }
+        // 2. split_frustum (Fig. 6b, c).
+        if let Some(min) = self.oracles.split
+            && self.should_split(f, &b, min)
+        {
+            self.counters.frusta_split += 1;
+            let (hx, hy) = ((f.x0 + f.x1) / 2, (f.y0 + f.y1) / 2);
+            for q in [
+                PixelRect {
+                    x0: f.x0,
+                    y0: f.y0,
+                    x1: hx,
+                    y1: hy,
+                },
+                PixelRect {
+                    x0: hx + 1,
+                    y0: f.y0,
+                    x1: f.x1,
+                    y1: hy,
+                },
+                PixelRect {
+                    x0: f.x0,
+                    y0: hy + 1,
+                    x1: hx,
+                    y1: f.y1,
+                },
+                PixelRect {
+                    x0: hx + 1,
+                    y0: hy + 1,
+                    x1: f.x1,
+                    y1: f.y1,
+                },
+            ] {
+                if q.x0 <= q.x1 && q.y0 <= q.y1 {
+                    self.counters.frusta_created += 1;
+                    self.traverse(q, node, b);
+                }
+            }
+            return;
+        }
+        match node {
+            // 3. generate_samples at leaves (Fig. 6d).
+            NodeRef::Leaf { start, count } => self.rasterize_leaf(f, start, count),
+            // 4. Children, nearest first.
+            NodeRef::Inner(index) => {
+                let n = &self.scene.bvh.cwbvh.nodes[index as usize];
+                let mut children: [(f32, NodeRef, NodeBox); 8] = [(0.0, node, b); 8];
+                let mut len = 0;
+                for c in 0..8 {
+                    if n.is_child_empty(c) {
+                        continue;
+                    }
+                    let aabb = n.child_aabb(c);
+                    let cb = self.node_box(aabb.min, aabb.max);
+                    let r = if n.is_leaf(c) {
+                        let (start, count) = n.child_primitives(c);
+                        NodeRef::Leaf { start, count }
+                    } else {
+                        NodeRef::Inner(n.child_node_index(c))
+                    };
+                    children[len] = (cb.min_w, r, cb);
+                    len += 1;
+                }
+                children[..len].sort_by(|a, b| a.0.total_cmp(&b.0));
+                for &(_, r, cb) in &children[..len] {
+                    self.traverse(f, r, cb);
+                }
+            }
+        }
+    }
+
+    /// Is the box wholly outside one of the frustum's side planes (through the eye
+    /// and the pixel borders of `f`), or nearer than `near`?
+    fn is_outside(&self, f: PixelRect, b: &NodeBox) -> bool {
+        let v = self.view;
+        let (fw, right, up) = (v.forward, v.right, v.up);
+        // Image x of a point is (c.x / c.z / tan_x + 1)·W/2; border lines at the
+        // rect's pixel edges (half a pixel beyond its outermost samples).
+        let kx = |x: u32| (2.0 * x as f32 / v.width as f32 - 1.0) * v.tan_half_x;
+        let ky = |y: u32| (1.0 - 2.0 * y as f32 / v.height as f32) * v.tan_half_y;
+        let planes = [
+            right - fw * kx(f.x0),     // x ≥ left border
+            fw * kx(f.x1 + 1) - right, // x ≤ right border
+            fw * ky(f.y0) - up,        // y ≥ top border (image y down)
+            up - fw * ky(f.y1 + 1),    // y ≤ bottom border
+        ];
+        let eye = Vec3A::from(v.eye);
+        let outside_plane = |n: Vec3| {
+            let n = Vec3A::from(n);
+            // The corner furthest along n.
+            let corner = Vec3A::select(n.cmpge(Vec3A::ZERO), b.hi, b.lo);
+            (corner - eye).dot(n) < 0.0
+        };
+        if planes.into_iter().any(outside_plane) {
+            return true;
+        }
+        // Wholly nearer than near: the farthest corner along the view axis.
+        let far = Vec3A::select(Vec3A::from(fw).cmpge(Vec3A::ZERO), b.hi, b.lo);
+        (far - eye).dot(Vec3A::from(fw)) < v.near
+    }
+
+    /// Split when the frustum is still larger than `min` and the node is not a
+    /// good fit: its box misses the frustum's centre ray, or it is small against
+    /// the frustum (paper §5, "3DR frustum split").
+    fn should_split(&self, f: PixelRect, b: &NodeBox, min: u32) -> bool {
+        let (w, h) = (f.x1 - f.x0 + 1, f.y1 - f.y0 + 1);
+        if w.max(h) <= min {
+            return false;
+        }
+        let v = self.view;
+        let (cx, cy) = (
+            (f.x0 + f.x1 + 1) as f32 * 0.5,
+            (f.y0 + f.y1 + 1) as f32 * 0.5,
+        );
+        if !SlabRay::new(v.eye, v.direction(cx, cy)).hits(b.lo, b.hi, f32::INFINITY) {
+            return true;
+        }
+        // Projected size of the box in pixels at its nearest distance.
+        let pixels_per_unit = v.height as f32 / (2.0 * v.tan_half_y * b.min_w.max(v.near));
+        let extent = (b.hi - b.lo).length() * pixels_per_unit;
+        extent < w.max(h) as f32 * 0.5
+    }
+
+    /// Sets up the leaf's triangles and rasterizes them over the frustum.
+    fn rasterize_leaf(&mut self, f: PixelRect, start: u32, count: u32) {
+        let scene = self.scene;
+        for slot in start..start + count {
+            let k = scene.bvh.cwbvh.primitive_indices[slot as usize];
+            let id = scene.drawable[k as usize];
+            let p = &scene.triangles[id as usize];
+            let Some(rect) = screen_rect(p, self.view) else {
+                continue;
+            };
+            let clip = PixelRect {
+                x0: rect.x0.max(f.x0),
+                y0: rect.y0.max(f.y0),
+                x1: rect.x1.min(f.x1),
+                y1: rect.y1.min(f.y1),
+            };
+            if clip.x0 > clip.x1 || clip.y0 > clip.y1 {
+                continue;
+            }
+            self.setups += 1;
+            let Some(tri) = Triangle3D::setup(p, self.view) else {
+                continue;
+            };
+            raster_triangle(
+                &mut self.tile,
+                &tri,
+                id,
+                clip,
+                self.oracles.samples,
+                &mut self.counters,
+            );
+        }
+        if self.oracles.occluded && !self.oracles.samples.early_z {
+            // Occlusion culling reads the hierarchical w-buffer: keep it current.
+            self.tile.update_hiz(f.x0, f.y0, f.x1, f.y1);
+        }
+    }
+}

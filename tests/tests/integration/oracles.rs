@@ -1,0 +1,92 @@
+//! Any point of the continuum renders the same image: random oracle settings and
+//! tile sizes against the family's brute-force reference.
+
+use continuum::AlgorithmId;
+use continuum_tests::{id_differences, prepared, render_with, render_with_oracles};
+use proptest::prelude::*;
+
+const W: u32 = 200;
+const H: u32 = 150;
+
+fn on(b: bool) -> &'static str {
+    if b { "on" } else { "off" }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, failure_persistence: None, ..ProptestConfig::default() })]
+
+    #[test]
+    fn bvh_traversal_oracles_never_change_the_image(
+        scene in prop::sample::select(vec!["bunny", "soup", "sphere", "orientation"]),
+        camera in 0usize..2,
+        outside in any::<bool>(),
+        occluded in any::<bool>(),
+        binning in any::<bool>(),
+        early_z in any::<bool>(),
+        split in prop::sample::select(vec!["off", "8", "16", "64"]),
+        frustum in prop::sample::select(vec![64u32, 128, 256]),
+        leaf in prop::sample::select(vec![4u32, 8, 16, 32]),
+    ) {
+        let p = prepared(scene);
+        let camera = &p.scene.cameras[camera];
+        let oracles = format!(
+            "outside={},occluded={},binning={},early_z={},split={split},frustum={frustum},leaf={leaf}",
+            on(outside), on(occluded), on(binning), on(early_z)
+        );
+        let reference = render_with(&p, AlgorithmId::ThreeDBrute, camera, W, H);
+        let out = render_with_oracles(&p, AlgorithmId::ThreeDFull, Some(&oracles), camera, W, H);
+        let diff = id_differences(&reference, &out);
+        prop_assert!(diff.is_empty(), "{scene}/{}: {oracles}: {} pixels differ, first {:?}", camera.name, diff.len(), &diff[..diff.len().min(5)]);
+        prop_assert_eq!(&reference.framebuffer.depth, &out.framebuffer.depth);
+    }
+
+    #[test]
+    fn binning_oracles_never_change_the_image(
+        scene in prop::sample::select(vec!["bunny", "soup", "grid", "box"]),
+        camera in 0usize..2,
+        two_d in any::<bool>(),
+        binning in any::<bool>(),
+        early_z in any::<bool>(),
+        leaf in prop::sample::select(vec![4u32, 8, 16, 32, 64]),
+    ) {
+        let p = prepared(scene);
+        let camera = &p.scene.cameras[camera];
+        let (brute, binned) = if two_d {
+            (AlgorithmId::TwoDBrute, AlgorithmId::TwoDBin)
+        } else {
+            (AlgorithmId::ThreeDBrute, AlgorithmId::ThreeDBin)
+        };
+        let oracles = format!("binning={},early_z={},leaf={leaf}", on(binning), on(early_z));
+        let reference = render_with(&p, brute, camera, W, H);
+        let out = render_with_oracles(&p, binned, Some(&oracles), camera, W, H);
+        let diff = id_differences(&reference, &out);
+        prop_assert!(diff.is_empty(), "{scene}/{} {binned}: {oracles}: {} pixels differ", camera.name, diff.len());
+    }
+}
+
+#[test]
+fn bad_oracles_are_errors_naming_the_field() {
+    let p = prepared("box");
+    let camera = p.scene.first_camera();
+    for (algorithm, text) in [
+        (AlgorithmId::ThreeDFull, "split=7"),
+        (AlgorithmId::ThreeDFull, "speed=fast"),
+        (AlgorithmId::ThreeDFull, "outside=maybe"),
+        (AlgorithmId::ThreeDBin, "split=8"),
+        (AlgorithmId::Raycast, "binning=on"),
+        (AlgorithmId::ThreeDFull, "binning"),
+    ] {
+        let err = continuum::render(
+            &p,
+            &continuum::RenderRequest {
+                algorithm,
+                oracles: Some(text.into()),
+                camera: camera.clone(),
+                width: 8,
+                height: 8,
+            },
+        )
+        .expect_err(text);
+        assert_eq!(err.field, "oracles", "{text}: {err}");
+    }
+}
