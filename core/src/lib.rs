@@ -21,6 +21,7 @@ pub mod clip;
 pub mod edge;
 pub mod framebuffer;
 pub mod maps;
+pub mod peer;
 pub mod prepared;
 pub mod render;
 pub mod request;

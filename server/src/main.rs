@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod cli_render;
+mod compare;
 mod serve;
 
 #[derive(Parser, Debug)]
@@ -26,12 +27,15 @@ enum Command {
     Serve(serve::ServeArgs),
     /// Render one image and print or write what it cost.
     Render(cli_render::RenderArgs),
+    /// Run every algorithm and peer on scenes and write what each cost.
+    Compare(compare::CompareArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Render(args)) => cli_render::run(&args),
+        Some(Command::Compare(args)) => compare::run(&args),
         Some(Command::Serve(args)) => serve::run(&args),
         None => serve::run(&serve::ServeArgs::default()),
     };

@@ -75,7 +75,10 @@ fn listings() {
         .iter()
         .filter_map(|a| a["id"].as_str())
         .collect();
-    let expected: Vec<&str> = continuum::AlgorithmId::ALL.iter().map(|a| a.as_str()).collect();
+    let expected: Vec<&str> = continuum::AlgorithmId::ALL
+        .iter()
+        .map(|a| a.as_str())
+        .collect();
     assert_eq!(ids, expected);
 }
 

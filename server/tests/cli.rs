@@ -216,3 +216,68 @@ fn bad_arguments_exit_2_naming_the_argument() {
         );
     }
 }
+
+#[test]
+fn compare_writes_results_with_the_documented_keys() {
+    let dir = out_dir("compare");
+    let out = continuum(&[
+        "compare",
+        "--scenes",
+        "box,sphere",
+        "--algorithms",
+        "2dr-brute,3dr-brute,3dr-full,raycast,peer-obvhs",
+        "--size",
+        "64x48",
+        "--repeat",
+        "2",
+        "--threads",
+        "2",
+        "--out",
+        dir.to_str().expect("utf-8"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("results.json")).expect("results.json"))
+            .expect("JSON");
+    assert!(doc["machine"].is_object() && doc["command"].is_string());
+    let rows = doc["rows"].as_array().expect("rows");
+    assert_eq!(rows.len(), 10);
+    for row in rows {
+        for key in [
+            "scene",
+            "algorithm",
+            "viewport",
+            "aa",
+            "width",
+            "height",
+            "threads",
+            "median_ms",
+            "min_ms",
+            "max_ms",
+            "ratio_to_2dr_brute",
+            "predicted_ratio",
+            "rays_per_second",
+            "stats",
+            "hashes",
+            "agrees",
+        ] {
+            assert!(row.get(key).is_some(), "missing {key}: {row}");
+        }
+        if row["algorithm"] != "peer-obvhs" {
+            assert_eq!(row["agrees"], true, "{row}");
+        }
+    }
+    let csv = std::fs::read_to_string(dir.join("results.csv")).expect("results.csv");
+    assert_eq!(csv.lines().count(), 11);
+}
+
+#[test]
+fn compare_refuses_unknown_algorithms() {
+    let out = continuum(&["compare", "--algorithms", "zbuffer", "--out", "/tmp/never"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--algorithms"));
+}

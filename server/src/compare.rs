@@ -1,0 +1,418 @@
+//! `continuum compare`: the benchmark. Every algorithm and peer on every scene,
+//! in one process, timed as medians over repeats and reported as ratios to
+//! `2dr-brute` (the paper's Fig. 9 form), with the counters that explain them.
+//! Writes `results.json` and `results.csv` into `--out`.
+
+use std::collections::HashMap;
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::Args;
+use continuum::peer::{PeerId, PreparedPeer};
+use continuum::request::{parse_algorithm, parse_size};
+use continuum::{AlgorithmId, PreparedScene, RenderRequest, View, render};
+use serde::Serialize;
+use serde_json::{Value, json};
+
+use crate::{CliError, scenes_dir};
+
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// Scenes: built-in names or paths, comma-separated [default: every built-in scene].
+    #[arg(long, value_delimiter = ',')]
+    scenes: Vec<String>,
+    /// Algorithm ids and peers (peer-obvhs), comma-separated [default: all].
+    #[arg(long, value_delimiter = ',')]
+    algorithms: Vec<String>,
+    /// Camera name; default: each scene's first camera.
+    #[arg(long)]
+    camera: Option<String>,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720", value_parser = |s: &str| parse_size(s).map_err(|e| e.message))]
+    size: (u32, u32),
+    /// Timed runs per scene and algorithm (after one warm-up run).
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    repeat: u32,
+    /// Worker threads [default: all cores].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    threads: Option<u32>,
+    /// Folder for results.json and results.csv.
+    #[arg(long)]
+    out: PathBuf,
+    /// Also print results.json on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Folder of built-in scenes.
+    #[arg(long = "scenes-dir")]
+    scenes_dir: Option<PathBuf>,
+}
+
+/// What one row measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Entry {
+    Algorithm(AlgorithmId),
+    Peer(PeerId),
+}
+
+impl Entry {
+    fn name(self) -> &'static str {
+        match self {
+            Entry::Algorithm(a) => a.as_str(),
+            Entry::Peer(p) => p.as_str(),
+        }
+    }
+}
+
+fn parse_entries(names: &[String]) -> Result<Vec<Entry>, CliError> {
+    if names.is_empty() {
+        let mut all: Vec<Entry> = AlgorithmId::ALL.into_iter().map(Entry::Algorithm).collect();
+        all.extend(PeerId::ALL.into_iter().map(Entry::Peer));
+        return Ok(all);
+    }
+    names
+        .iter()
+        .map(|n| match PeerId::parse(n) {
+            Some(p) => Ok(Entry::Peer(p)),
+            None => parse_algorithm(n).map(Entry::Algorithm).map_err(|e| {
+                CliError::Usage(format!(
+                    "--algorithms: {}; peers are: {}",
+                    e.message,
+                    PeerId::ALL.map(|p| p.as_str()).join(", ")
+                ))
+            }),
+        })
+        .collect()
+}
+
+/// One measured row of results.json.
+#[derive(Debug, Serialize)]
+struct Row {
+    scene: String,
+    algorithm: String,
+    viewport: String,
+    aa: String,
+    width: u32,
+    height: u32,
+    threads: usize,
+    median_ms: f64,
+    min_ms: f64,
+    max_ms: f64,
+    ratio_to_2dr_brute: Option<f64>,
+    predicted_ratio: Option<f64>,
+    rays_per_second: f64,
+    stats: Value,
+    hashes: Value,
+    /// Does the triangle-id buffer equal its family's reference (for peers: 3dr-brute)?
+    agrees: bool,
+    /// Pixels whose triangle id differs from 3dr-brute's (peers are not watertight).
+    pixels_differing_from_3dr_brute: Option<u64>,
+}
+
+fn median(mut v: Vec<f64>) -> (f64, f64, f64) {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    let m = if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    };
+    (m, v[0], v[n - 1])
+}
+
+pub fn run(args: &CompareArgs) -> Result<(), CliError> {
+    let entries = parse_entries(&args.algorithms)?;
+    let dir = scenes_dir(args.scenes_dir.as_ref());
+    let scene_args = if args.scenes.is_empty() {
+        continuum::scene::builtin_names(&dir)
+    } else {
+        args.scenes.clone()
+    };
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let threads = args
+        .threads
+        .map_or_else(rayon::current_num_threads, |t| t as usize);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("building the thread pool")?;
+    let (width, height) = args.size;
+
+    let total_steps = (scene_args.len() * entries.len()) as u64;
+    let progress = indicatif::ProgressBar::new(total_steps).with_style(
+        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} [{elapsed}]")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+
+    let mut rows = Vec::new();
+    for scene_arg in &scene_args {
+        let scene = continuum::scene::load_named_or_path(scene_arg, &dir)
+            .map_err(|e| CliError::Usage(format!("--scenes: {e}")))?;
+        let camera = match &args.camera {
+            Some(name) => scene
+                .camera(name)
+                .map_err(|e| CliError::Usage(format!("--camera: {e}")))?,
+            None => scene.first_camera(),
+        };
+        progress.set_message(format!("{}: preparing", scene.name));
+        let prepared = pool.install(|| PreparedScene::new(scene));
+        let scene_name = prepared.scene.name.clone();
+        let view = View::new(&camera, width, height, prepared.default_near)
+            .map_err(|e| CliError::Usage(format!("--camera: {e}")))?;
+        let mut scene_rows: Vec<(Row, Vec<u32>)> = Vec::new();
+        for &entry in &entries {
+            progress.set_message(format!("{scene_name}: {}", entry.name()));
+            let (row, ids) = match entry {
+                Entry::Algorithm(a) => {
+                    measure_algorithm(&pool, &prepared, &camera, a, args, threads, &scene_name)?
+                }
+                Entry::Peer(p) => measure_peer(
+                    &pool,
+                    &prepared,
+                    &view,
+                    p,
+                    args.repeat,
+                    threads,
+                    &scene_name,
+                ),
+            };
+            scene_rows.push((row, ids));
+            progress.inc(1);
+        }
+        fill_relations(&mut scene_rows);
+        rows.extend(scene_rows.into_iter().map(|(r, _)| r));
+    }
+    progress.finish_and_clear();
+
+    let doc = json!({
+        "machine": machine(threads),
+        "command": std::env::args().collect::<Vec<_>>().join(" "),
+        "rows": rows,
+    });
+    let text = serde_json::to_string_pretty(&doc).context("encoding results")?;
+    std::fs::write(args.out.join("results.json"), &text).context("writing results.json")?;
+    write_csv(&args.out.join("results.csv"), &rows)?;
+    if args.json {
+        println!("{text}");
+    } else {
+        print_table(&rows);
+    }
+    Ok(())
+}
+
+fn measure_algorithm(
+    pool: &rayon::ThreadPool,
+    prepared: &PreparedScene,
+    camera: &continuum::Camera,
+    algorithm: AlgorithmId,
+    args: &CompareArgs,
+    threads: usize,
+    scene: &str,
+) -> Result<(Row, Vec<u32>), CliError> {
+    let request = RenderRequest {
+        algorithm,
+        oracles: None,
+        camera: camera.clone(),
+        width: args.size.0,
+        height: args.size.1,
+    };
+    let mut out = pool
+        .install(|| render(prepared, &request))
+        .map_err(|e| CliError::Usage(format!("--{e}")))?;
+    let mut times = Vec::new();
+    for _ in 0..args.repeat {
+        out = pool
+            .install(|| render(prepared, &request))
+            .map_err(|e| CliError::Usage(format!("--{e}")))?;
+        times.push(out.stats.time_ms.total);
+    }
+    let (median_ms, min_ms, max_ms) = median(times);
+    let pixels = f64::from(args.size.0) * f64::from(args.size.1);
+    let row = Row {
+        scene: scene.to_string(),
+        algorithm: algorithm.as_str().into(),
+        viewport: out.viewport.clone(),
+        aa: out.aa.clone(),
+        width: args.size.0,
+        height: args.size.1,
+        threads,
+        median_ms,
+        min_ms,
+        max_ms,
+        ratio_to_2dr_brute: None,
+        predicted_ratio: None,
+        rays_per_second: pixels / (median_ms / 1e3),
+        stats: serde_json::to_value(&out.stats).unwrap_or(Value::Null),
+        hashes: serde_json::to_value(&out.hashes).unwrap_or(Value::Null),
+        agrees: true,
+        pixels_differing_from_3dr_brute: None,
+    };
+    Ok((row, out.framebuffer.triangle_id))
+}
+
+fn measure_peer(
+    pool: &rayon::ThreadPool,
+    prepared: &PreparedScene,
+    view: &View,
+    peer: PeerId,
+    repeat: u32,
+    threads: usize,
+    scene: &str,
+) -> (Row, Vec<u32>) {
+    let prepared_peer = pool.install(|| PreparedPeer::new(peer, prepared));
+    let mut out = pool.install(|| prepared_peer.render(view));
+    let mut times = Vec::new();
+    for _ in 0..repeat {
+        out = pool.install(|| prepared_peer.render(view));
+        times.push(out.time_ms);
+    }
+    let (median_ms, min_ms, max_ms) = median(times);
+    let pixels = f64::from(view.width) * f64::from(view.height);
+    let row = Row {
+        scene: scene.to_string(),
+        algorithm: peer.as_str().into(),
+        viewport: "perspective".into(),
+        aa: "none".into(),
+        width: view.width,
+        height: view.height,
+        threads,
+        median_ms,
+        min_ms,
+        max_ms,
+        ratio_to_2dr_brute: None,
+        predicted_ratio: None,
+        rays_per_second: pixels / (median_ms / 1e3),
+        stats: json!({ "bvh_build_ms": prepared_peer.build_ms }),
+        hashes: Value::Null,
+        agrees: false,
+        pixels_differing_from_3dr_brute: None,
+    };
+    (row, out.triangle_id)
+}
+
+/// Ratios to 2dr-brute, family agreement and peer differences within one scene.
+fn fill_relations(rows: &mut [(Row, Vec<u32>)]) {
+    let find =
+        |rows: &[(Row, Vec<u32>)], name: &str| rows.iter().position(|(r, _)| r.algorithm == name);
+    let base = find(rows, "2dr-brute").map(|i| {
+        let r = &rows[i].0;
+        (r.median_ms, r.stats["predicted_instructions"].as_f64())
+    });
+    let three_d = find(rows, "3dr-brute").map(|i| rows[i].1.clone());
+    // The first member of each family present is its reference.
+    let mut family_reference: HashMap<String, usize> = HashMap::new();
+    for i in 0..rows.len() {
+        let name = rows[i].0.algorithm.clone();
+        if let Some((base_ms, base_instr)) = base {
+            rows[i].0.ratio_to_2dr_brute = Some(rows[i].0.median_ms / base_ms);
+            if let (Some(bi), Some(pi)) = (
+                base_instr,
+                rows[i].0.stats["predicted_instructions"].as_f64(),
+            ) {
+                rows[i].0.predicted_ratio = Some(pi / bi);
+            }
+        }
+        match AlgorithmId::ALL.into_iter().find(|a| a.as_str() == name) {
+            Some(a) => {
+                let family = format!("{:?}", a.family());
+                let reference = *family_reference.entry(family).or_insert(i);
+                rows[i].0.agrees = rows[i].1 == rows[reference].1;
+            }
+            None => {
+                if let Some(ids) = &three_d {
+                    let differing =
+                        ids.iter().zip(&rows[i].1).filter(|(a, b)| a != b).count() as u64;
+                    rows[i].0.pixels_differing_from_3dr_brute = Some(differing);
+                    rows[i].0.agrees = differing == 0;
+                }
+            }
+        }
+    }
+}
+
+fn machine(threads: usize) -> Value {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into());
+    json!({
+        "cpu": cpu,
+        "logical_cores": std::thread::available_parallelism().map_or(0, |n| n.get()),
+        "threads": threads,
+        "os": std::env::consts::OS,
+        "arch": std::env::consts::ARCH,
+        "continuum_version": env!("CARGO_PKG_VERSION"),
+    })
+}
+
+fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
+    let mut f =
+        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
+    let mut text = String::from(
+        "scene,algorithm,width,height,threads,median_ms,min_ms,max_ms,ratio_to_2dr_brute,predicted_ratio,rays_per_second,triangle_setups,edge_evaluations,bvh_nodes_visited,agrees,pixels_differing_from_3dr_brute,triangle_id_hash\n",
+    );
+    let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.4}"));
+    for r in rows {
+        let stat = |k: &str| {
+            r.stats
+                .get(k)
+                .and_then(Value::as_u64)
+                .map_or(String::new(), |v| v.to_string())
+        };
+        text.push_str(&format!(
+            "{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{:.0},{},{},{},{},{},{}\n",
+            r.scene,
+            r.algorithm,
+            r.width,
+            r.height,
+            r.threads,
+            r.median_ms,
+            r.min_ms,
+            r.max_ms,
+            opt(r.ratio_to_2dr_brute),
+            opt(r.predicted_ratio),
+            r.rays_per_second,
+            stat("triangle_setups"),
+            stat("edge_evaluations"),
+            stat("bvh_nodes_visited"),
+            r.agrees,
+            r.pixels_differing_from_3dr_brute
+                .map_or(String::new(), |v| v.to_string()),
+            r.hashes
+                .get("triangle_id")
+                .and_then(Value::as_str)
+                .unwrap_or(""),
+        ));
+    }
+    f.write_all(text.as_bytes())
+        .context("writing results.csv")?;
+    Ok(())
+}
+
+fn print_table(rows: &[Row]) {
+    println!(
+        "{:<12} {:<18} {:>10} {:>8} {:>9} {:>12} {:>7}",
+        "scene", "algorithm", "median ms", "ratio", "predicted", "Mrays/s", "agrees"
+    );
+    for r in rows {
+        let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.2}"));
+        println!(
+            "{:<12} {:<18} {:>10.2} {:>8} {:>9} {:>12.2} {:>7}",
+            r.scene,
+            r.algorithm,
+            r.median_ms,
+            opt(r.ratio_to_2dr_brute),
+            opt(r.predicted_ratio),
+            r.rays_per_second / 1e6,
+            match r.pixels_differing_from_3dr_brute {
+                Some(d) => format!("{d} px"),
+                None => r.agrees.to_string(),
+            }
+        );
+    }
+}
