@@ -12,6 +12,7 @@ use std::time::{Duration, Instant};
 
 use glam::{UVec2, Vec3, Vec3A};
 use obvhs::BvhBuildParams;
+use wide::f32x8;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::node::{CwBvhNode, extract_byte64};
@@ -124,12 +125,18 @@ pub struct SlabRay {
     inv: [f32; 3],
 }
 
+/// Direction components smaller than this are treated as this (with their sign):
+/// the slab test then stays exact for rays parallel to a slab (an origin inside
+/// gives an interval of ±10³⁰, one outside never enters) and never forms 0·∞.
+const TINY_DIRECTION: f32 = 1e-30;
+
 impl SlabRay {
     pub fn new(origin: Vec3, dir: Vec3) -> SlabRay {
+        let safe = dir.to_array().map(|d| if d.abs() < TINY_DIRECTION { TINY_DIRECTION.copysign(d) } else { d });
         SlabRay {
             origin: origin.to_array(),
             dir: dir.to_array(),
-            inv: (Vec3::ONE / dir).to_array(),
+            inv: safe.map(|d| 1.0 / d),
         }
     }
 
@@ -140,7 +147,7 @@ impl SlabRay {
         let mut t0 = 0.0f32;
         let mut t1 = tmax;
         for a in 0..3 {
-            if self.dir[a].abs() < 1e-30 {
+            if self.dir[a].abs() < TINY_DIRECTION {
                 // Parallel to the slab: inside it or never.
                 if self.origin[a] < lo[a] || self.origin[a] > hi[a] {
                     return false;
@@ -155,20 +162,39 @@ impl SlabRay {
         t0 <= t1
     }
 
-    /// obvhs's hit mask for the children of `node` this ray meets before `tmax`.
+    /// obvhs's hit mask for the children of `node` this ray meets before `tmax`:
+    /// the eight child boxes are decoded and slab-tested side by side (8 lanes).
     #[inline(always)]
     fn child_hitmask(&self, node: &CwBvhNode, tmax: f32, oct_inv4: u32) -> u32 {
-        let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
         let extent = node.compute_extent();
         let p = Vec3A::from(node.p);
+        // One pad for the node: BOX_PAD of its largest coordinate magnitude.
+        let far = p + extent * 255.0;
+        let pad = f32x8::splat(p.abs().max(far.abs()).max_element() * BOX_PAD + f32::MIN_POSITIVE);
+        let lanes = |q: [u8; 8]| f32x8::from(q.map(f32::from));
+        let axis = |qlo: [u8; 8], qhi: [u8; 8], a: usize| {
+            let (e, base) = (f32x8::splat(extent[a]), f32x8::splat(p[a]));
+            let (o, inv) = (f32x8::splat(self.origin[a]), f32x8::splat(self.inv[a]));
+            let lo = lanes(qlo) * e + base - pad;
+            let hi = lanes(qhi) * e + base + pad;
+            let (ta, tb) = ((lo - o) * inv, (hi - o) * inv);
+            (ta.fast_min(tb), ta.fast_max(tb))
+        };
+        let (nx, fx) = axis(node.child_min_x, node.child_max_x, 0);
+        let (ny, fy) = axis(node.child_min_y, node.child_max_y, 1);
+        let (nz, fz) = axis(node.child_min_z, node.child_max_z, 2);
+        let near = nx.fast_max(ny).fast_max(nz.fast_max(f32x8::ZERO));
+        let far = fx.fast_min(fy).fast_min(fz.fast_min(f32x8::splat(tmax)));
+        let mut hits = near.simd_le(far).to_bitmask();
+        if hits == 0 {
+            return 0;
+        }
+        let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
         let mut mask = 0;
-        for child in 0..8 {
-            if node.is_child_empty(child) {
-                continue;
-            }
-            let local = node.local_child_aabb(child);
-            let (lo, hi) = padded(local.min * extent + p, local.max * extent + p);
-            if self.hits(lo, hi, tmax) {
+        while hits != 0 {
+            let child = hits.trailing_zeros() as usize;
+            hits &= hits - 1;
+            if !node.is_child_empty(child) {
                 mask |= extract_byte64(child_bits8, child) << extract_byte64(bit_index8, child);
             }
         }
