@@ -12,10 +12,10 @@ use std::time::{Duration, Instant};
 
 use glam::{UVec2, Vec3, Vec3A};
 use obvhs::BvhBuildParams;
-use wide::f32x8;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::node::{CwBvhNode, extract_byte64};
+use wide::f32x8;
 
 /// Relative padding of every box, beyond CWBVH quantisation and rounding.
 pub const BOX_PAD: f32 = 1.0 / (1 << 18) as f32;
@@ -132,7 +132,13 @@ const TINY_DIRECTION: f32 = 1e-30;
 
 impl SlabRay {
     pub fn new(origin: Vec3, dir: Vec3) -> SlabRay {
-        let safe = dir.to_array().map(|d| if d.abs() < TINY_DIRECTION { TINY_DIRECTION.copysign(d) } else { d });
+        let safe = dir.to_array().map(|d| {
+            if d.abs() < TINY_DIRECTION {
+                TINY_DIRECTION.copysign(d)
+            } else {
+                d
+            }
+        });
         SlabRay {
             origin: origin.to_array(),
             dir: dir.to_array(),

@@ -3,13 +3,14 @@
 //! own intersectors; comparisons report how many pixels differ, never assert it.
 //!
 //! - `peer-obvhs`: obvhs's CWBVH built from its `Triangle`s and walked with its
-//!   own `ray_traverse` and `Triangle::intersect`, one ray per pixel, as a user of
-//!   that library writes it.
+//!   own `ray_traverse` and `Triangle::intersect`, one ray per pixel.
+//! - `peer-embree`, `peer-embree-stream` (cargo feature `embree`): Embree 3 with
+//!   one `rtcIntersect1` per pixel, or each image row as one coherent stream
+//!   (`rtcIntersect1M`), both with a coherent intersect context.
 
 use std::time::{Duration, Instant};
 
 use glam::Vec3A;
-use obvhs::cwbvh::CwBvh;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use rayon::prelude::*;
@@ -22,103 +23,209 @@ use crate::prepared::PreparedScene;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum PeerId {
     Obvhs,
+    EmbreeSingle,
+    EmbreeStream,
 }
 
 impl PeerId {
-    pub const ALL: [PeerId; 1] = [PeerId::Obvhs];
+    pub const ALL: [PeerId; 3] = [PeerId::Obvhs, PeerId::EmbreeSingle, PeerId::EmbreeStream];
 
     pub fn as_str(self) -> &'static str {
         match self {
             PeerId::Obvhs => "peer-obvhs",
+            PeerId::EmbreeSingle => "peer-embree",
+            PeerId::EmbreeStream => "peer-embree-stream",
         }
     }
 
     pub fn parse(s: &str) -> Option<PeerId> {
         PeerId::ALL.into_iter().find(|p| p.as_str() == s)
     }
-}
 
-/// The triangle ids a peer found, per pixel.
-#[derive(Clone, Debug)]
-pub struct PeerOutput {
-    pub triangle_id: Vec<u32>,
-    /// Wall time of the ray loop in milliseconds.
-    pub time_ms: f64,
-}
-
-/// A peer's scene data, built once (not part of the timed loop).
-#[derive(Debug)]
-pub struct PreparedPeer {
-    pub id: PeerId,
-    triangles: Vec<Triangle>,
-    bvh: CwBvh,
-    /// Triangle id of each entry of `triangles`.
-    ids: Vec<u32>,
-    pub build_ms: f64,
-}
-
-impl PreparedPeer {
-    pub fn new(id: PeerId, scene: &PreparedScene) -> PreparedPeer {
-        let start = Instant::now();
-        let ids = scene.drawable.clone();
-        let triangles: Vec<Triangle> = ids
-            .iter()
-            .map(|&i| {
-                let [a, b, c] = scene.triangles[i as usize];
-                Triangle {
-                    v0: a.into(),
-                    v1: b.into(),
-                    v2: c.into(),
-                }
-            })
-            .collect();
-        let bvh = if triangles.is_empty() {
-            CwBvh::default()
-        } else {
-            obvhs::cwbvh::builder::build_cwbvh_from_tris(
-                &triangles,
-                obvhs::BvhBuildParams::medium_build(),
-                &mut Duration::default(),
-            )
-        };
-        PreparedPeer {
-            id,
-            triangles,
-            bvh,
-            ids,
-            build_ms: start.elapsed().as_secs_f64() * 1e3,
+    /// Whether this build can run the peer.
+    pub fn available(self) -> bool {
+        match self {
+            PeerId::Obvhs => true,
+            PeerId::EmbreeSingle | PeerId::EmbreeStream => cfg!(feature = "embree"),
         }
     }
+}
 
-    /// One closest-hit ray per pixel centre, in parallel over rows.
-    pub fn render(&self, view: &View) -> PeerOutput {
+/// What a peer run measured: its build time, the wall time of each timed
+/// repetition (after one warm-up), and the triangle ids it found.
+#[derive(Clone, Debug)]
+pub struct PeerRun {
+    pub build_ms: f64,
+    pub times_ms: Vec<f64>,
+    pub triangle_id: Vec<u32>,
+}
+
+/// Builds the peer's own acceleration structure from `scene` (timed apart), then
+/// casts one closest-hit ray per pixel centre `1 + repeat` times.
+pub fn run_peer(
+    peer: PeerId,
+    scene: &PreparedScene,
+    view: &View,
+    repeat: u32,
+) -> Result<PeerRun, String> {
+    match peer {
+        PeerId::Obvhs => Ok(run_obvhs(scene, view, repeat)),
+        #[cfg(feature = "embree")]
+        PeerId::EmbreeSingle | PeerId::EmbreeStream => Ok(embree_peer::run(
+            scene,
+            view,
+            repeat,
+            peer == PeerId::EmbreeStream,
+        )),
+        #[cfg(not(feature = "embree"))]
+        PeerId::EmbreeSingle | PeerId::EmbreeStream => Err(format!(
+            "{} needs continuum built with the `embree` feature (and Debian's libembree-dev)",
+            peer.as_str()
+        )),
+    }
+}
+
+/// Times `1 + repeat` runs of `f`, keeping the last result.
+fn timed(repeat: u32, mut f: impl FnMut() -> Vec<u32>) -> (Vec<f64>, Vec<u32>) {
+    let mut ids = f();
+    let mut times = Vec::new();
+    for _ in 0..repeat {
         let start = Instant::now();
-        let width = view.width as usize;
+        ids = f();
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+    }
+    (times, ids)
+}
+
+fn run_obvhs(scene: &PreparedScene, view: &View, repeat: u32) -> PeerRun {
+    let start = Instant::now();
+    let triangles: Vec<Triangle> = scene
+        .drawable
+        .iter()
+        .map(|&i| {
+            let [a, b, c] = scene.triangles[i as usize];
+            Triangle {
+                v0: a.into(),
+                v1: b.into(),
+                v2: c.into(),
+            }
+        })
+        .collect();
+    let bvh = (!triangles.is_empty()).then(|| {
+        obvhs::cwbvh::builder::build_cwbvh_from_tris(
+            &triangles,
+            obvhs::BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        )
+    });
+    let build_ms = start.elapsed().as_secs_f64() * 1e3;
+    let (times_ms, triangle_id) = timed(repeat, || {
         let mut ids = vec![BACKGROUND; view.pixel_count()];
-        if !self.triangles.is_empty() {
+        if let Some(bvh) = &bvh {
+            ids.par_chunks_mut(view.width as usize)
+                .enumerate()
+                .for_each(|(y, row)| {
+                    let yc = pixel_center(y as u32);
+                    for (x, out) in row.iter_mut().enumerate() {
+                        let dir = view.direction(pixel_center(x as u32), yc);
+                        let ray =
+                            Ray::new(Vec3A::from(view.eye), Vec3A::from(dir), 0.0, f32::INFINITY);
+                        let mut hit = RayHit::none();
+                        if bvh.ray_traverse(ray, &mut hit, |ray, id| {
+                            triangles[bvh.primitive_indices[id] as usize].intersect(ray)
+                        }) {
+                            *out = scene.drawable
+                                [bvh.primitive_indices[hit.primitive_id as usize] as usize];
+                        }
+                    }
+                });
+        }
+        ids
+    });
+    PeerRun {
+        build_ms,
+        times_ms,
+        triangle_id,
+    }
+}
+
+#[cfg(feature = "embree")]
+mod embree_peer {
+    use std::time::Instant;
+
+    use cgmath::{Vector3, Vector4};
+    use embree::{Device, Geometry, IntersectContext, Ray, RayHit, Scene, TriangleMesh};
+    use rayon::prelude::*;
+
+    use super::{PeerRun, timed};
+    use crate::camera::{View, pixel_center};
+    use crate::framebuffer::BACKGROUND;
+    use crate::prepared::PreparedScene;
+
+    pub fn run(scene: &PreparedScene, view: &View, repeat: u32, stream: bool) -> PeerRun {
+        let start = Instant::now();
+        let device = Device::new();
+        let n = scene.drawable.len();
+        let mut mesh = TriangleMesh::unanimated(&device, n, 3 * n);
+        {
+            let mut vertices = mesh.vertex_buffer.map();
+            for (k, &id) in scene.drawable.iter().enumerate() {
+                for (j, p) in scene.triangles[id as usize].iter().enumerate() {
+                    vertices[3 * k + j] = Vector4::new(p.x, p.y, p.z, 0.0);
+                }
+            }
+        }
+        {
+            let mut indices = mesh.index_buffer.map();
+            for k in 0..n {
+                let base = 3 * k as u32;
+                indices[k] = Vector3::new(base, base + 1, base + 2);
+            }
+        }
+        let mut geometry = Geometry::Triangle(mesh);
+        geometry.commit();
+        let mut embree_scene = Scene::new(&device);
+        embree_scene.attach_geometry(geometry);
+        let committed = embree_scene.commit();
+        let build_ms = start.elapsed().as_secs_f64() * 1e3;
+
+        let eye = Vector3::new(view.eye.x, view.eye.y, view.eye.z);
+        let ray_at = |x: usize, y: usize| {
+            let d = view.direction(pixel_center(x as u32), pixel_center(y as u32));
+            RayHit::new(Ray::new(eye, Vector3::new(d.x, d.y, d.z)))
+        };
+        let id_of = |hit: &RayHit| {
+            if hit.hit.geomID == u32::MAX {
+                BACKGROUND
+            } else {
+                scene.drawable[hit.hit.primID as usize]
+            }
+        };
+        let width = view.width as usize;
+        let (times_ms, triangle_id) = timed(repeat, || {
+            let mut ids = vec![BACKGROUND; view.pixel_count()];
             ids.par_chunks_mut(width).enumerate().for_each(|(y, row)| {
-                let yc = pixel_center(y as u32);
-                for (x, out) in row.iter_mut().enumerate() {
-                    let dir = view.direction(pixel_center(x as u32), yc);
-                    let ray = Ray::new(
-                        Vec3A::from(view.eye),
-                        Vec3A::from(dir),
-                        view.near,
-                        f32::INFINITY,
-                    );
-                    let mut hit = RayHit::none();
-                    if self.bvh.ray_traverse(ray, &mut hit, |ray, id| {
-                        self.triangles[self.bvh.primitive_indices[id] as usize].intersect(ray)
-                    }) {
-                        *out = self.ids
-                            [self.bvh.primitive_indices[hit.primitive_id as usize] as usize];
+                let mut ctx = IntersectContext::coherent();
+                if stream {
+                    let mut rays: Vec<RayHit> = (0..width).map(|x| ray_at(x, y)).collect();
+                    committed.intersect_stream_aos(&mut ctx, &mut rays);
+                    for (out, hit) in row.iter_mut().zip(&rays) {
+                        *out = id_of(hit);
+                    }
+                } else {
+                    for (x, out) in row.iter_mut().enumerate() {
+                        let mut hit = ray_at(x, y);
+                        committed.intersect(&mut ctx, &mut hit);
+                        *out = id_of(&hit);
                     }
                 }
             });
-        }
-        PeerOutput {
-            triangle_id: ids,
-            time_ms: start.elapsed().as_secs_f64() * 1e3,
+            ids
+        });
+        PeerRun {
+            build_ms,
+            times_ms,
+            triangle_id,
         }
     }
 }

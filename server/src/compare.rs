@@ -9,7 +9,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use continuum::peer::{PeerId, PreparedPeer};
+use continuum::peer::{PeerId, run_peer};
 use continuum::request::{parse_algorithm, parse_size};
 use continuum::{AlgorithmId, PreparedScene, RenderRequest, View, render};
 use serde::Serialize;
@@ -22,7 +22,8 @@ pub struct CompareArgs {
     /// Scenes: built-in names or paths, comma-separated [default: every built-in scene].
     #[arg(long, value_delimiter = ',')]
     scenes: Vec<String>,
-    /// Algorithm ids and peers (peer-obvhs), comma-separated [default: all].
+    /// Algorithm ids and peers (peer-obvhs; peer-embree and peer-embree-stream with
+    /// the `embree` feature), comma-separated [default: all that are built in].
     #[arg(long, value_delimiter = ',')]
     algorithms: Vec<String>,
     /// Camera name; default: each scene's first camera.
@@ -67,12 +68,20 @@ impl Entry {
 fn parse_entries(names: &[String]) -> Result<Vec<Entry>, CliError> {
     if names.is_empty() {
         let mut all: Vec<Entry> = AlgorithmId::ALL.into_iter().map(Entry::Algorithm).collect();
-        all.extend(PeerId::ALL.into_iter().map(Entry::Peer));
+        all.extend(
+            PeerId::ALL
+                .into_iter()
+                .filter(|p| p.available())
+                .map(Entry::Peer),
+        );
         return Ok(all);
     }
     names
         .iter()
         .map(|n| match PeerId::parse(n) {
+            Some(p) if !p.available() => Err(CliError::Usage(format!(
+                "--algorithms: {n} needs continuum built with --features embree (and Debian's libembree-dev)"
+            ))),
             Some(p) => Ok(Entry::Peer(p)),
             None => parse_algorithm(n).map(Entry::Algorithm).map_err(|e| {
                 CliError::Usage(format!(
@@ -175,7 +184,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
                     args.repeat,
                     threads,
                     &scene_name,
-                ),
+                )?,
             };
             scene_rows.push((row, ids));
             progress.inc(1);
@@ -259,15 +268,11 @@ fn measure_peer(
     repeat: u32,
     threads: usize,
     scene: &str,
-) -> (Row, Vec<u32>) {
-    let prepared_peer = pool.install(|| PreparedPeer::new(peer, prepared));
-    let mut out = pool.install(|| prepared_peer.render(view));
-    let mut times = Vec::new();
-    for _ in 0..repeat {
-        out = pool.install(|| prepared_peer.render(view));
-        times.push(out.time_ms);
-    }
-    let (median_ms, min_ms, max_ms) = median(times);
+) -> Result<(Row, Vec<u32>), CliError> {
+    let run = pool
+        .install(|| run_peer(peer, prepared, view, repeat))
+        .map_err(|e| CliError::Usage(format!("--algorithms: {e}")))?;
+    let (median_ms, min_ms, max_ms) = median(run.times_ms);
     let pixels = f64::from(view.width) * f64::from(view.height);
     let row = Row {
         scene: scene.to_string(),
@@ -283,12 +288,12 @@ fn measure_peer(
         ratio_to_2dr_brute: None,
         predicted_ratio: None,
         rays_per_second: pixels / (median_ms / 1e3),
-        stats: json!({ "bvh_build_ms": prepared_peer.build_ms }),
+        stats: json!({ "bvh_build_ms": run.build_ms }),
         hashes: Value::Null,
         agrees: false,
         pixels_differing_from_3dr_brute: None,
     };
-    (row, out.triangle_id)
+    Ok((row, run.triangle_id))
 }
 
 /// Ratios to 2dr-brute, family agreement and peer differences within one scene.

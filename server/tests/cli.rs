@@ -281,3 +281,53 @@ fn compare_refuses_unknown_algorithms() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--algorithms"));
 }
+
+/// With the `embree` feature, Embree 3 runs beside us (single rays and streams).
+#[cfg(feature = "embree")]
+#[test]
+fn compare_runs_the_embree_peers() {
+    let dir = out_dir("embree");
+    let out = continuum(&[
+        "compare",
+        "--scenes",
+        "sphere",
+        "--algorithms",
+        "3dr-brute,peer-embree,peer-embree-stream",
+        "--size",
+        "64x48",
+        "--repeat",
+        "1",
+        "--out",
+        dir.to_str().expect("utf-8"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("results.json")).expect("results.json"))
+            .expect("JSON");
+    for row in &doc["rows"].as_array().expect("rows")[1..] {
+        // Embree is not watertight, but on a closed sphere it should miss very little.
+        let differing = row["pixels_differing_from_3dr_brute"]
+            .as_u64()
+            .expect("count");
+        assert!(differing < 64 * 48 / 100, "{row}");
+        assert!(row["rays_per_second"].as_f64().expect("rate") > 0.0);
+    }
+}
+
+#[cfg(not(feature = "embree"))]
+#[test]
+fn embree_peers_need_the_feature() {
+    let out = continuum(&[
+        "compare",
+        "--algorithms",
+        "peer-embree",
+        "--out",
+        "/tmp/never",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("embree"));
+}
