@@ -20,12 +20,50 @@ use wide::f32x8;
 /// Relative padding of every box, beyond CWBVH quantisation and rounding.
 pub const BOX_PAD: f32 = 1.0 / (1 << 18) as f32;
 
+/// The eight child boxes of a CWBVH node, decoded to f32 and padded, laid out
+/// for 8-lane slab tests (empty children hold zeros and are masked out).
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(32))]
+pub struct ChildBoxes {
+    pub lo: [[f32; 8]; 3],
+    pub hi: [[f32; 8]; 3],
+}
+
 /// A BVH over triangles. Its primitives are indices into `drawable`.
 #[derive(Clone, Debug)]
 pub struct SceneBvh {
     pub cwbvh: CwBvh,
+    /// Per node, its children's boxes in world space, padded by [`BOX_PAD`].
+    pub child_boxes: Vec<ChildBoxes>,
     /// Build wall time in milliseconds.
     pub build_ms: f64,
+}
+
+/// Index of `node` in `bvh.nodes` (the traversal hands out references).
+#[inline(always)]
+fn node_index(bvh: &CwBvh, node: &CwBvhNode) -> usize {
+    // Both point into the same slice, so the offset is exact.
+    (node as *const CwBvhNode as usize - bvh.nodes.as_ptr() as usize)
+        / std::mem::size_of::<CwBvhNode>()
+}
+
+/// Decodes a node's quantised child boxes to world space, padded.
+fn decode_children(node: &CwBvhNode) -> ChildBoxes {
+    let mut boxes = ChildBoxes::default();
+    let extent = node.compute_extent();
+    let p = Vec3A::from(node.p);
+    for child in 0..8 {
+        if node.is_child_empty(child) {
+            continue;
+        }
+        let local = node.local_child_aabb(child);
+        let (lo, hi) = padded(local.min * extent + p, local.max * extent + p);
+        for a in 0..3 {
+            boxes.lo[a][child] = lo[a];
+            boxes.hi[a][child] = hi[a];
+        }
+    }
+    boxes
 }
 
 /// Pads a box by [`BOX_PAD`] of its largest coordinate magnitude (plus a tiny
@@ -57,8 +95,10 @@ impl SceneBvh {
                 &mut Duration::default(),
             )
         };
+        let child_boxes = cwbvh.nodes.iter().map(decode_children).collect();
         SceneBvh {
             cwbvh,
+            child_boxes,
             build_ms: start.elapsed().as_secs_f64() * 1e3,
         }
     }
@@ -86,10 +126,11 @@ impl SceneBvh {
         );
     }
 
-    /// Walks the BVH along `origin + t·dir` front to back. `leaf(k)` is called for
-    /// each primitive `k` (an index into `drawable`) of every leaf the ray reaches
-    /// and returns the current culling distance: nodes entered beyond it are
-    /// skipped. Returns the number of nodes whose children were tested.
+    /// Walks the BVH along `origin + t·dir` front to back. `leaf(slot)` is called
+    /// for each primitive slot (an index into `primitive_indices`, leaves hold
+    /// consecutive slots) of every leaf the ray reaches and returns the current
+    /// culling distance: nodes entered beyond it are skipped. Returns the number
+    /// of nodes whose children were tested.
     #[inline]
     pub fn walk(&self, origin: Vec3, dir: Vec3, mut leaf: impl FnMut(u32) -> f32) -> u64 {
         if self.cwbvh.nodes.is_empty() {
@@ -107,10 +148,15 @@ impl SceneBvh {
             state,
             {
                 visited += 1;
-                ray.child_hitmask(node, tmax, state.oct_inv4)
+                ray.child_hitmask(
+                    node,
+                    &self.child_boxes[node_index(bvh, node)],
+                    tmax,
+                    state.oct_inv4,
+                )
             },
             {
-                tmax = leaf(bvh.primitive_indices[state.primitive_id as usize]);
+                tmax = leaf(state.primitive_id);
             }
         );
         visited
@@ -123,6 +169,11 @@ pub struct SlabRay {
     origin: [f32; 3],
     dir: [f32; 3],
     inv: [f32; 3],
+    /// The origin moved by its own rounding pad: subtracted from lower bounds
+    /// (`origin_lo`) and upper bounds (`origin_hi`), it widens every slab by more
+    /// than the subtraction can round.
+    origin_lo: [f32; 3],
+    origin_hi: [f32; 3],
 }
 
 /// Direction components smaller than this are treated as this (with their sign):
@@ -132,6 +183,7 @@ const TINY_DIRECTION: f32 = 1e-30;
 
 impl SlabRay {
     pub fn new(origin: Vec3, dir: Vec3) -> SlabRay {
+        let pad = origin.abs().max_element() * BOX_PAD;
         let safe = dir.to_array().map(|d| {
             if d.abs() < TINY_DIRECTION {
                 TINY_DIRECTION.copysign(d)
@@ -143,6 +195,8 @@ impl SlabRay {
             origin: origin.to_array(),
             dir: dir.to_array(),
             inv: safe.map(|d| 1.0 / d),
+            origin_lo: (origin + Vec3::splat(pad)).to_array(),
+            origin_hi: (origin - Vec3::splat(pad)).to_array(),
         }
     }
 
@@ -168,27 +222,19 @@ impl SlabRay {
         t0 <= t1
     }
 
-    /// obvhs's hit mask for the children of `node` this ray meets before `tmax`:
-    /// the eight child boxes are decoded and slab-tested side by side (8 lanes).
+    /// obvhs's hit mask for the children of `node` (boxes `boxes`) this ray meets
+    /// before `tmax`: eight slab tests side by side.
     #[inline(always)]
-    fn child_hitmask(&self, node: &CwBvhNode, tmax: f32, oct_inv4: u32) -> u32 {
-        let extent = node.compute_extent();
-        let p = Vec3A::from(node.p);
-        // One pad for the node: BOX_PAD of its largest coordinate magnitude.
-        let far = p + extent * 255.0;
-        let pad = f32x8::splat(p.abs().max(far.abs()).max_element() * BOX_PAD + f32::MIN_POSITIVE);
-        let lanes = |q: [u8; 8]| f32x8::from(q.map(f32::from));
-        let axis = |qlo: [u8; 8], qhi: [u8; 8], a: usize| {
-            let (e, base) = (f32x8::splat(extent[a]), f32x8::splat(p[a]));
-            let (o, inv) = (f32x8::splat(self.origin[a]), f32x8::splat(self.inv[a]));
-            let lo = lanes(qlo) * e + base - pad;
-            let hi = lanes(qhi) * e + base + pad;
-            let (ta, tb) = ((lo - o) * inv, (hi - o) * inv);
+    fn child_hitmask(&self, node: &CwBvhNode, boxes: &ChildBoxes, tmax: f32, oct_inv4: u32) -> u32 {
+        let axis = |a: usize| {
+            let inv = f32x8::splat(self.inv[a]);
+            let ta = (f32x8::from(boxes.lo[a]) - f32x8::splat(self.origin_lo[a])) * inv;
+            let tb = (f32x8::from(boxes.hi[a]) - f32x8::splat(self.origin_hi[a])) * inv;
             (ta.fast_min(tb), ta.fast_max(tb))
         };
-        let (nx, fx) = axis(node.child_min_x, node.child_max_x, 0);
-        let (ny, fy) = axis(node.child_min_y, node.child_max_y, 1);
-        let (nz, fz) = axis(node.child_min_z, node.child_max_z, 2);
+        let (nx, fx) = axis(0);
+        let (ny, fy) = axis(1);
+        let (nz, fz) = axis(2);
         let near = nx.fast_max(ny).fast_max(nz.fast_max(f32x8::ZERO));
         let far = fx.fast_min(fy).fast_min(fz.fast_min(f32x8::splat(tmax)));
         let mut hits = near.simd_le(far).to_bitmask();

@@ -22,6 +22,9 @@ pub struct PreparedScene {
     /// vertices, or an f32 cross product of exactly zero).
     pub drawable: Vec<u32>,
     pub bvh: SceneBvh,
+    /// Triangle id of each BVH primitive slot: `drawable[primitive_indices[slot]]`,
+    /// so per-slot data sits in the order leaves read it.
+    pub slot_triangles: Vec<u32>,
     pub bounds: Bounds,
     /// Near distance for cameras that give none: 1e-3 of the bounding radius.
     pub default_near: f32,
@@ -50,6 +53,12 @@ impl PreparedScene {
             .collect();
         let face_normals = raw_normals.iter().map(|n| n.normalize_or_zero()).collect();
         let bvh = SceneBvh::build(&triangles, &drawable);
+        let slot_triangles = bvh
+            .cwbvh
+            .primitive_indices
+            .iter()
+            .map(|&k| drawable[k as usize])
+            .collect();
         let bounds = scene.bounds();
         let radius = if bounds.is_empty() {
             1.0
@@ -61,6 +70,7 @@ impl PreparedScene {
             face_normals,
             drawable,
             bvh,
+            slot_triangles,
             bounds,
             default_near: radius * 1e-3,
             scene,

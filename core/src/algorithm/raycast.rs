@@ -31,7 +31,7 @@ pub(crate) fn render_raycast(
     // 1. Setup: the 3D edge functions of every drawable triangle for this view.
     let start = Instant::now();
     let setups: Vec<Option<Triangle3D>> = scene
-        .drawable
+        .slot_triangles
         .par_iter()
         .map(|&id| Triangle3D::setup(&scene.triangles[id as usize], view))
         .collect();
@@ -56,7 +56,7 @@ pub(crate) fn render_raycast(
                             evals += 1;
                             if let Some(w) = tri.sample(xc, yc) {
                                 covered += 1;
-                                let id = scene.drawable[k as usize];
+                                let id = scene.slot_triangles[k as usize];
                                 if w < best_w || (w == best_w && id < best_id) {
                                     best_w = w;
                                     best_id = id;
