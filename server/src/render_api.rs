@@ -127,6 +127,9 @@ async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, 
         };
         let out = continuum::render(&prepared, &request)
             .map_err(|e| ApiError::bad_request(e.field, e.to_string()))?;
+        job_state
+            .metrics
+            .observe_render(request.algorithm.as_str(), out.stats.time_ms.total / 1e3);
         Ok((out, prepared.scene.name.clone(), request.camera.name))
     })
     .await;
@@ -220,12 +223,28 @@ pub async fn scenes(State(state): State<Arc<AppState>>) -> Result<Json<Value>, A
             .scene_names()
             .into_iter()
             .map(|name| match state.prepared(&name) {
-                Ok(p) => json!({
-                    "name": name,
-                    "triangles": p.triangle_count(),
-                    "cameras": p.scene.camera_names(),
-                    "lights": p.scene.lights.len(),
-                }),
+                Ok(p) => {
+                    let mut cameras = p.scene.cameras.clone();
+                    if !cameras.iter().any(|c| c.name == "default") {
+                        cameras.push(p.scene.default_camera());
+                    }
+                    let cameras: Vec<Value> = cameras
+                        .iter()
+                        .map(|c| {
+                            json!({
+                                "name": c.name, "eye": c.eye.to_array(), "target": c.target.to_array(),
+                                "up": c.up.to_array(), "fov_y": c.fov_y_deg, "near": c.near,
+                            })
+                        })
+                        .collect();
+                    json!({
+                        "name": name,
+                        "triangles": p.triangle_count(),
+                        "cameras": cameras,
+                        "lights": p.scene.lights.len(),
+                        "warnings": p.scene.warnings,
+                    })
+                }
                 Err(e) => json!({ "name": name, "error": e.error }),
             })
             .collect::<Vec<_>>()

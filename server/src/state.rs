@@ -33,6 +33,7 @@ pub struct AppState {
     pub scenes_dir: PathBuf,
     pub limits: Limits,
     pub(crate) renders: Arc<Semaphore>,
+    pub(crate) metrics: crate::metrics::Metrics,
     cache: Mutex<HashMap<String, Arc<PreparedScene>>>,
 }
 
@@ -42,8 +43,14 @@ impl AppState {
             scenes_dir,
             renders: Arc::new(Semaphore::new(limits.max_concurrent_renders.max(1))),
             limits,
+            metrics: crate::metrics::Metrics::default(),
             cache: Mutex::new(HashMap::new()),
         })
+    }
+
+    /// How many prepared scenes are cached.
+    pub fn cached_scenes(&self) -> usize {
+        self.cache.lock().map_or(0, |c| c.len())
     }
 
     /// Names of the scenes this service serves.

@@ -83,6 +83,32 @@ fn listings() {
 }
 
 #[test]
+fn web_page_and_metrics() {
+    let s = state(Limits::default());
+    let (status, page) = get(&s, "/");
+    assert_eq!(status, StatusCode::OK);
+    let page = String::from_utf8(page).expect("utf-8");
+    assert!(page.contains("<title>continuum</title>") && page.contains("/api/render"));
+    get(
+        &s,
+        "/api/render.png?scene=box&algorithm=3dr-full&size=16x16",
+    );
+    get(&s, "/api/render.png?scene=box&algorithm=nope");
+    let (status, text) = get(&s, "/metrics");
+    assert_eq!(status, StatusCode::OK);
+    let text = String::from_utf8(text).expect("utf-8");
+    for line in [
+        "continuum_requests_total{route=\"/api/render.png\",status=\"200\"} 1",
+        "continuum_requests_total{route=\"/api/render.png\",status=\"400\"} 1",
+        "continuum_render_seconds_count{algorithm=\"3dr-full\"} 1",
+        "continuum_renders_in_flight 0",
+        "continuum_scene_cache_size 1",
+    ] {
+        assert!(text.contains(line), "missing {line} in\n{text}");
+    }
+}
+
+#[test]
 fn render_json_and_png() {
     let s = state(Limits::default());
     let (status, doc) = post(

@@ -1,0 +1,123 @@
+//! Prometheus text metrics: requests by route and status, render time
+//! histograms by algorithm, renders in flight, prepared scenes cached.
+
+use std::collections::BTreeMap;
+use std::fmt::Write;
+use std::sync::{Arc, Mutex};
+
+use axum::extract::{MatchedPath, Request, State};
+use axum::middleware::Next;
+use axum::response::{IntoResponse, Response};
+
+use crate::state::AppState;
+
+/// Upper bounds of the render-time buckets, seconds.
+const BUCKETS: [f64; 11] = [
+    0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1.0, 2.5, 5.0, 10.0,
+];
+
+#[derive(Debug, Default)]
+struct Histogram {
+    counts: [u64; BUCKETS.len()],
+    count: u64,
+    sum: f64,
+}
+
+/// The service's counters.
+#[derive(Debug, Default)]
+pub struct Metrics {
+    requests: Mutex<BTreeMap<(String, u16), u64>>,
+    renders: Mutex<BTreeMap<String, Histogram>>,
+}
+
+impl Metrics {
+    pub fn count_request(&self, route: &str, status: u16) {
+        if let Ok(mut m) = self.requests.lock() {
+            *m.entry((route.to_string(), status)).or_default() += 1;
+        }
+    }
+
+    pub fn observe_render(&self, algorithm: &str, seconds: f64) {
+        if let Ok(mut m) = self.renders.lock() {
+            let h = m.entry(algorithm.to_string()).or_default();
+            for (c, &b) in h.counts.iter_mut().zip(&BUCKETS) {
+                if seconds <= b {
+                    *c += 1;
+                }
+            }
+            h.count += 1;
+            h.sum += seconds;
+        }
+    }
+
+    fn render_text(&self, in_flight: usize, cached: usize) -> String {
+        let mut out = String::new();
+        out.push_str("# HELP continuum_requests_total HTTP requests by route and status.\n");
+        out.push_str("# TYPE continuum_requests_total counter\n");
+        if let Ok(m) = self.requests.lock() {
+            for ((route, status), n) in m.iter() {
+                let _ = writeln!(
+                    out,
+                    "continuum_requests_total{{route=\"{route}\",status=\"{status}\"}} {n}"
+                );
+            }
+        }
+        out.push_str("# HELP continuum_render_seconds Render wall time by algorithm.\n");
+        out.push_str("# TYPE continuum_render_seconds histogram\n");
+        if let Ok(m) = self.renders.lock() {
+            for (algorithm, h) in m.iter() {
+                for (c, b) in h.counts.iter().zip(BUCKETS) {
+                    let _ = writeln!(
+                        out,
+                        "continuum_render_seconds_bucket{{algorithm=\"{algorithm}\",le=\"{b}\"}} {c}"
+                    );
+                }
+                let _ = writeln!(
+                    out,
+                    "continuum_render_seconds_bucket{{algorithm=\"{algorithm}\",le=\"+Inf\"}} {}",
+                    h.count
+                );
+                let _ = writeln!(
+                    out,
+                    "continuum_render_seconds_sum{{algorithm=\"{algorithm}\"}} {}",
+                    h.sum
+                );
+                let _ = writeln!(
+                    out,
+                    "continuum_render_seconds_count{{algorithm=\"{algorithm}\"}} {}",
+                    h.count
+                );
+            }
+        }
+        out.push_str("# HELP continuum_renders_in_flight Renders running now.\n# TYPE continuum_renders_in_flight gauge\n");
+        let _ = writeln!(out, "continuum_renders_in_flight {in_flight}");
+        out.push_str("# HELP continuum_scene_cache_size Prepared scenes held in memory.\n# TYPE continuum_scene_cache_size gauge\n");
+        let _ = writeln!(out, "continuum_scene_cache_size {cached}");
+        out
+    }
+}
+
+/// Middleware: counts every request by its matched route and final status.
+pub async fn track(State(state): State<Arc<AppState>>, request: Request, next: Next) -> Response {
+    let route = request
+        .extensions()
+        .get::<MatchedPath>()
+        .map_or_else(|| "unmatched".to_string(), |p| p.as_str().to_string());
+    let response = next.run(request).await;
+    state
+        .metrics
+        .count_request(&route, response.status().as_u16());
+    response
+}
+
+/// `GET /metrics`.
+pub async fn metrics(State(state): State<Arc<AppState>>) -> impl IntoResponse {
+    let in_flight = state.limits.max_concurrent_renders.max(1) - state.renders.available_permits();
+    (
+        [(
+            axum::http::header::CONTENT_TYPE,
+            "text/plain; version=0.0.4",
+        )],
+        state.metrics.render_text(in_flight, state.cached_scenes()),
+    )
+}
