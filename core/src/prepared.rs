@@ -77,6 +77,21 @@ impl PreparedScene {
         }
     }
 
+    /// Approximate heap size in bytes (for cache bounds).
+    pub fn approx_bytes(&self) -> usize {
+        let mesh = &self.scene.mesh;
+        mesh.positions.len() * 12
+            + mesh.normals.len() * 12
+            + mesh.uvs.len() * 8
+            + mesh.triangles.len() * 16
+            + self.triangles.len() * 36
+            + self.face_normals.len() * 12
+            + self.drawable.len() * 4
+            + self.slot_triangles.len() * 4
+            + self.bvh.cwbvh.nodes.len() * (80 + 192)
+            + self.bvh.cwbvh.primitive_indices.len() * 4
+    }
+
     /// Triangle count, degenerate ones included.
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()

@@ -37,6 +37,19 @@ impl ApiError {
         }
     }
 
+    pub fn with_status(status: StatusCode, field: Option<&str>, error: impl Into<String>) -> ApiError {
+        ApiError {
+            status,
+            error: error.into(),
+            field: field.map(str::to_string),
+        }
+    }
+
+    /// A request body that could not be read (too large, cut off).
+    pub fn body(rejection: &axum::extract::rejection::BytesRejection) -> ApiError {
+        ApiError::with_status(rejection.status(), Some("body"), rejection.body_text())
+    }
+
     pub fn internal(error: impl Into<String>) -> ApiError {
         ApiError {
             status: StatusCode::INTERNAL_SERVER_ERROR,

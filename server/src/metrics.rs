@@ -50,7 +50,7 @@ impl Metrics {
         }
     }
 
-    fn render_text(&self, in_flight: usize, cached: usize) -> String {
+    fn render_text(&self, in_flight: usize, cached: usize, cached_bytes: usize) -> String {
         let mut out = String::new();
         out.push_str("# HELP continuum_requests_total HTTP requests by route and status.\n");
         out.push_str("# TYPE continuum_requests_total counter\n");
@@ -93,6 +93,8 @@ impl Metrics {
         let _ = writeln!(out, "continuum_renders_in_flight {in_flight}");
         out.push_str("# HELP continuum_scene_cache_size Prepared scenes held in memory.\n# TYPE continuum_scene_cache_size gauge\n");
         let _ = writeln!(out, "continuum_scene_cache_size {cached}");
+        out.push_str("# HELP continuum_scene_cache_bytes Approximate memory of the cached scenes.\n# TYPE continuum_scene_cache_bytes gauge\n");
+        let _ = writeln!(out, "continuum_scene_cache_bytes {cached_bytes}");
         out
     }
 }
@@ -113,11 +115,9 @@ pub async fn track(State(state): State<Arc<AppState>>, request: Request, next: N
 /// `GET /metrics`.
 pub async fn metrics(State(state): State<Arc<AppState>>) -> impl IntoResponse {
     let in_flight = state.limits.max_concurrent_renders.max(1) - state.renders.available_permits();
+    let (cached, bytes) = state.cache_usage();
     (
-        [(
-            axum::http::header::CONTENT_TYPE,
-            "text/plain; version=0.0.4",
-        )],
-        state.metrics.render_text(in_flight, state.cached_scenes()),
+        [(axum::http::header::CONTENT_TYPE, "text/plain; version=0.0.4")],
+        state.metrics.render_text(in_flight, cached, bytes),
     )
 }

@@ -111,7 +111,8 @@ async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, 
         .try_acquire_owned()
         .map_err(|_| ApiError::overloaded())?;
     let job_state = state.clone();
-    let result = tokio::task::spawn_blocking(move || {
+    let timeout = state.limits.render_timeout;
+    let job = tokio::task::spawn_blocking(move || {
         let _permit = permit;
         let prepared = job_state.prepared(&c.scene)?;
         let mut camera = CameraSpec::resolve(c.camera.as_ref(), &prepared.scene)?;
@@ -131,8 +132,16 @@ async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, 
             .metrics
             .observe_render(request.algorithm.as_str(), out.stats.time_ms.total / 1e3);
         Ok((out, prepared.scene.name.clone(), request.camera.name))
-    })
-    .await;
+    });
+    // The job keeps its render slot until it ends, so a timed-out render still
+    // counts against the concurrency limit.
+    let result = tokio::time::timeout(timeout, job).await.map_err(|_| {
+        ApiError::with_status(
+            axum::http::StatusCode::GATEWAY_TIMEOUT,
+            None,
+            format!("the render did not finish within {} s", timeout.as_secs_f64()),
+        )
+    })?;
     result.map_err(|e| ApiError::internal(format!("render failed: {e}")))?
 }
 
@@ -150,8 +159,9 @@ fn image(out: &RenderOutput, name: &str) -> Vec<u8> {
 /// `POST /api/render`.
 pub async fn render_json(
     State(state): State<Arc<AppState>>,
-    body: Bytes,
+    body: Result<Bytes, axum::extract::rejection::BytesRejection>,
 ) -> Result<Json<Value>, ApiError> {
+    let body = body.map_err(|e| ApiError::body(&e))?;
     let body: RenderBody = serde_json::from_slice(&body).map_err(|e| json_error(&e))?;
     let checked = check(&body, &state)?;
     let (out, scene, camera) = run(state, checked).await?;
@@ -280,7 +290,7 @@ fn json_error(e: &serde_json::Error) -> ApiError {
 }
 
 /// Pulls the field name out of serde's "unknown field `x`" / "missing field `x`".
-fn unknown_or_missing_field(text: &str) -> Option<String> {
+pub(crate) fn unknown_or_missing_field(text: &str) -> Option<String> {
     for marker in ["unknown field `", "missing field `"] {
         if let Some(start) = text.find(marker) {
             let rest = &text[start + marker.len()..];

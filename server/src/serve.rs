@@ -17,6 +17,57 @@ pub struct ServeArgs {
     /// Folder of scenes to serve (default: the built-in scenes).
     #[arg(long)]
     pub scenes: Option<PathBuf>,
+    /// Most pixels in one render [default: 4096000].
+    #[arg(long)]
+    pub max_pixels: Option<u64>,
+    /// Renders running at once; more are answered 503 [default: cores].
+    #[arg(long)]
+    pub max_concurrent: Option<usize>,
+    /// Seconds before a render is answered 504 [default: 60].
+    #[arg(long)]
+    pub render_timeout: Option<f64>,
+    /// Largest request body or upload in MiB [default: 32].
+    #[arg(long)]
+    pub max_body_mib: Option<usize>,
+    /// Most triangles of an uploaded scene [default: 2000000].
+    #[arg(long)]
+    pub max_upload_triangles: Option<usize>,
+    /// Memory for prepared scenes in MiB [default: 2048].
+    #[arg(long)]
+    pub cache_mib: Option<usize>,
+}
+
+impl ServeArgs {
+    /// The limits these flags ask for, each checked.
+    fn limits(&self) -> Result<Limits, CliError> {
+        let mut l = Limits::default();
+        let positive = |name: &str, ok: bool| if ok { Ok(()) } else { Err(CliError::Usage(format!("--{name}: must be positive"))) };
+        if let Some(v) = self.max_pixels {
+            positive("max-pixels", v > 0)?;
+            l.max_pixels = v;
+        }
+        if let Some(v) = self.max_concurrent {
+            positive("max-concurrent", v > 0)?;
+            l.max_concurrent_renders = v;
+        }
+        if let Some(v) = self.render_timeout {
+            positive("render-timeout", v > 0.0 && v.is_finite())?;
+            l.render_timeout = std::time::Duration::from_secs_f64(v);
+        }
+        if let Some(v) = self.max_body_mib {
+            positive("max-body-mib", v > 0)?;
+            l.max_body_bytes = v << 20;
+        }
+        if let Some(v) = self.max_upload_triangles {
+            positive("max-upload-triangles", v > 0)?;
+            l.max_upload_triangles = v;
+        }
+        if let Some(v) = self.cache_mib {
+            positive("cache-mib", v > 0)?;
+            l.max_cache_bytes = v << 20;
+        }
+        Ok(l)
+    }
 }
 
 pub fn run(args: &ServeArgs) -> Result<(), CliError> {
@@ -33,13 +84,14 @@ pub fn run(args: &ServeArgs) -> Result<(), CliError> {
             dir.display()
         )));
     }
+    let limits = args.limits()?;
     let runtime = tokio::runtime::Runtime::new().context("starting the async runtime")?;
     runtime.block_on(async move {
         let listener = tokio::net::TcpListener::bind(&addr)
             .await
             .map_err(|e| CliError::Usage(format!("--addr: cannot listen on {addr}: {e}")))?;
-        let state = AppState::new(dir.clone(), Limits::default());
-        tracing::info!(%addr, scenes = %dir.display(), "continuum serving");
+        tracing::info!(%addr, scenes = %dir.display(), ?limits, "continuum serving");
+        let state = AppState::new(dir.clone(), limits);
         axum::serve(listener, app(state))
             .with_graceful_shutdown(shutdown_signal())
             .await

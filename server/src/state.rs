@@ -1,29 +1,101 @@
-//! Shared state: the scenes folder, prepared scenes built once and cached, and the
-//! limits that keep one request from taking the machine.
+//! Shared state: the scenes folder, prepared scenes built once and kept in a
+//! memory-bounded cache, uploaded scenes, and the limits that keep one request
+//! from taking the machine.
 
 use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
+use std::time::Duration;
 
 use continuum::PreparedScene;
 use tokio::sync::Semaphore;
 
 use crate::error::ApiError;
 
-/// Request limits (all configurable).
+/// Request limits (all configurable from `continuum serve`).
 #[derive(Clone, Debug)]
 pub struct Limits {
     /// Most pixels in one render.
     pub max_pixels: u64,
+    /// Most samples per pixel a request may ask for (anti-aliasing modes).
+    pub max_samples_per_pixel: u32,
     /// Renders running at once; more get 503.
     pub max_concurrent_renders: usize,
+    /// A render not finished by then is answered with 504 (it still completes).
+    pub render_timeout: Duration,
+    /// Largest request body (JSON requests and `.glb` uploads), bytes.
+    pub max_body_bytes: usize,
+    /// Most triangles an uploaded scene may have.
+    pub max_upload_triangles: usize,
+    /// Memory for prepared scenes; least recently used ones are dropped beyond it.
+    pub max_cache_bytes: usize,
 }
 
 impl Default for Limits {
     fn default() -> Self {
         Limits {
             max_pixels: 2560 * 1600,
+            max_samples_per_pixel: 1,
             max_concurrent_renders: std::thread::available_parallelism().map_or(2, |n| n.get()),
+            render_timeout: Duration::from_secs(60),
+            max_body_bytes: 32 << 20,
+            max_upload_triangles: 2_000_000,
+            max_cache_bytes: 2 << 30,
+        }
+    }
+}
+
+/// A cached prepared scene and when it was last used.
+#[derive(Debug)]
+struct Cached {
+    scene: Arc<PreparedScene>,
+    bytes: usize,
+    last_used: u64,
+    /// Uploaded scenes cannot be reloaded from disk once dropped.
+    uploaded: bool,
+}
+
+#[derive(Debug, Default)]
+struct Cache {
+    entries: HashMap<String, Cached>,
+    clock: u64,
+}
+
+impl Cache {
+    fn get(&mut self, name: &str) -> Option<Arc<PreparedScene>> {
+        self.clock += 1;
+        let clock = self.clock;
+        self.entries.get_mut(name).map(|c| {
+            c.last_used = clock;
+            c.scene.clone()
+        })
+    }
+
+    /// Inserts, then drops least recently used entries (never the new one) until
+    /// the total fits `max_bytes`.
+    fn insert(&mut self, name: &str, scene: Arc<PreparedScene>, uploaded: bool, max_bytes: usize) {
+        self.clock += 1;
+        let bytes = scene.approx_bytes();
+        self.entries.insert(
+            name.to_string(),
+            Cached {
+                scene,
+                bytes,
+                last_used: self.clock,
+                uploaded,
+            },
+        );
+        while self.entries.values().map(|c| c.bytes).sum::<usize>() > max_bytes {
+            let Some(oldest) = self
+                .entries
+                .iter()
+                .filter(|(n, _)| n.as_str() != name)
+                .min_by_key(|(_, c)| c.last_used)
+                .map(|(n, _)| n.clone())
+            else {
+                break;
+            };
+            self.entries.remove(&oldest);
         }
     }
 }
@@ -34,7 +106,7 @@ pub struct AppState {
     pub limits: Limits,
     pub(crate) renders: Arc<Semaphore>,
     pub(crate) metrics: crate::metrics::Metrics,
-    cache: Mutex<HashMap<String, Arc<PreparedScene>>>,
+    cache: Mutex<Cache>,
 }
 
 impl AppState {
@@ -44,52 +116,60 @@ impl AppState {
             renders: Arc::new(Semaphore::new(limits.max_concurrent_renders.max(1))),
             limits,
             metrics: crate::metrics::Metrics::default(),
-            cache: Mutex::new(HashMap::new()),
+            cache: Mutex::new(Cache::default()),
         })
     }
 
-    /// How many prepared scenes are cached.
-    pub fn cached_scenes(&self) -> usize {
-        self.cache.lock().map_or(0, |c| c.len())
+    fn cache(&self) -> Result<std::sync::MutexGuard<'_, Cache>, ApiError> {
+        self.cache.lock().map_err(|_| ApiError::internal("scene cache poisoned"))
     }
 
-    /// Names of the scenes this service serves.
-    pub fn scene_names(&self) -> Vec<String> {
-        continuum::scene::builtin_names(&self.scenes_dir)
-    }
-
-    /// The prepared scene `name` (a scene of the scenes folder, never a path),
-    /// loaded and prepared on first use. Blocking: call off the async runtime.
-    pub fn prepared(&self, name: &str) -> Result<Arc<PreparedScene>, ApiError> {
-        if let Some(p) = self
-            .cache
+    /// How many prepared scenes are cached, and their approximate bytes.
+    pub fn cache_usage(&self) -> (usize, usize) {
+        self.cache
             .lock()
-            .map_err(|_| ApiError::internal("scene cache poisoned"))?
-            .get(name)
-        {
-            return Ok(p.clone());
+            .map_or((0, 0), |c| (c.entries.len(), c.entries.values().map(|e| e.bytes).sum()))
+    }
+
+    /// Names of the scenes this service serves: the scenes folder's and the
+    /// uploads still cached.
+    pub fn scene_names(&self) -> Vec<String> {
+        let mut names = continuum::scene::builtin_names(&self.scenes_dir);
+        if let Ok(cache) = self.cache.lock() {
+            let mut uploads: Vec<String> =
+                cache.entries.iter().filter(|(_, c)| c.uploaded).map(|(n, _)| n.clone()).collect();
+            uploads.sort();
+            names.extend(uploads);
         }
-        if !self.scene_names().iter().any(|n| n == name) {
+        names
+    }
+
+    /// The prepared scene `name` (a scene of the scenes folder or an upload,
+    /// never a path), loaded and prepared on first use. Blocking: call off the
+    /// async runtime.
+    pub fn prepared(&self, name: &str) -> Result<Arc<PreparedScene>, ApiError> {
+        if let Some(p) = self.cache()?.get(name) {
+            return Ok(p);
+        }
+        if !continuum::scene::builtin_names(&self.scenes_dir).iter().any(|n| n == name) {
             return Err(ApiError::bad_request(
                 "scene",
-                format!(
-                    "unknown scene '{name}'; scenes are: {}",
-                    self.scene_names().join(", ")
-                ),
+                format!("unknown scene '{name}'; scenes are: {}", self.scene_names().join(", ")),
             ));
         }
         let scene = continuum::scene::load_named_or_path(name, &self.scenes_dir)
             .map_err(|e| ApiError::internal(format!("scene '{name}' failed to load: {e}")))?;
         let prepared = Arc::new(PreparedScene::new(scene));
-        self.cache
-            .lock()
-            .map_err(|_| ApiError::internal("scene cache poisoned"))?
-            .insert(name.to_string(), prepared.clone());
+        self.cache()?.insert(name, prepared.clone(), false, self.limits.max_cache_bytes);
         Ok(prepared)
     }
-}
 
-impl AppState {
+    /// Keeps an uploaded, prepared scene under `name`.
+    pub fn add_upload(&self, name: &str, scene: Arc<PreparedScene>) -> Result<(), ApiError> {
+        self.cache()?.insert(name, scene, true, self.limits.max_cache_bytes);
+        Ok(())
+    }
+
     /// The render-slot semaphore, so tests can hold slots as long renders would.
     #[doc(hidden)]
     pub fn renders_for_test(&self) -> Arc<Semaphore> {
