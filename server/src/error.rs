@@ -37,7 +37,11 @@ impl ApiError {
         }
     }
 
-    pub fn with_status(status: StatusCode, field: Option<&str>, error: impl Into<String>) -> ApiError {
+    pub fn with_status(
+        status: StatusCode,
+        field: Option<&str>,
+        error: impl Into<String>,
+    ) -> ApiError {
         ApiError {
             status,
             error: error.into(),

@@ -40,7 +40,9 @@ pub fn app(state: Arc<AppState>) -> Router {
         .route("/api/render.png", get(render_api::render_png))
         .route("/metrics", get(metrics::metrics))
         .fallback(|| async { ApiError::not_found("path", "no such route") })
-        .layer(axum::extract::DefaultBodyLimit::max(state.limits.max_body_bytes))
+        .layer(axum::extract::DefaultBodyLimit::max(
+            state.limits.max_body_bytes,
+        ))
         .layer(axum::middleware::from_fn_with_state(
             state.clone(),
             metrics::track,

@@ -117,7 +117,10 @@ pub async fn metrics(State(state): State<Arc<AppState>>) -> impl IntoResponse {
     let in_flight = state.limits.max_concurrent_renders.max(1) - state.renders.available_permits();
     let (cached, bytes) = state.cache_usage();
     (
-        [(axum::http::header::CONTENT_TYPE, "text/plain; version=0.0.4")],
+        [(
+            axum::http::header::CONTENT_TYPE,
+            "text/plain; version=0.0.4",
+        )],
         state.metrics.render_text(in_flight, cached, bytes),
     )
 }

@@ -139,7 +139,10 @@ async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, 
         ApiError::with_status(
             axum::http::StatusCode::GATEWAY_TIMEOUT,
             None,
-            format!("the render did not finish within {} s", timeout.as_secs_f64()),
+            format!(
+                "the render did not finish within {} s",
+                timeout.as_secs_f64()
+            ),
         )
     })?;
     result.map_err(|e| ApiError::internal(format!("render failed: {e}")))?

@@ -41,7 +41,13 @@ impl ServeArgs {
     /// The limits these flags ask for, each checked.
     fn limits(&self) -> Result<Limits, CliError> {
         let mut l = Limits::default();
-        let positive = |name: &str, ok: bool| if ok { Ok(()) } else { Err(CliError::Usage(format!("--{name}: must be positive"))) };
+        let positive = |name: &str, ok: bool| {
+            if ok {
+                Ok(())
+            } else {
+                Err(CliError::Usage(format!("--{name}: must be positive")))
+            }
+        };
         if let Some(v) = self.max_pixels {
             positive("max-pixels", v > 0)?;
             l.max_pixels = v;

@@ -121,14 +121,16 @@ impl AppState {
     }
 
     fn cache(&self) -> Result<std::sync::MutexGuard<'_, Cache>, ApiError> {
-        self.cache.lock().map_err(|_| ApiError::internal("scene cache poisoned"))
+        self.cache
+            .lock()
+            .map_err(|_| ApiError::internal("scene cache poisoned"))
     }
 
     /// How many prepared scenes are cached, and their approximate bytes.
     pub fn cache_usage(&self) -> (usize, usize) {
-        self.cache
-            .lock()
-            .map_or((0, 0), |c| (c.entries.len(), c.entries.values().map(|e| e.bytes).sum()))
+        self.cache.lock().map_or((0, 0), |c| {
+            (c.entries.len(), c.entries.values().map(|e| e.bytes).sum())
+        })
     }
 
     /// Names of the scenes this service serves: the scenes folder's and the
@@ -136,8 +138,12 @@ impl AppState {
     pub fn scene_names(&self) -> Vec<String> {
         let mut names = continuum::scene::builtin_names(&self.scenes_dir);
         if let Ok(cache) = self.cache.lock() {
-            let mut uploads: Vec<String> =
-                cache.entries.iter().filter(|(_, c)| c.uploaded).map(|(n, _)| n.clone()).collect();
+            let mut uploads: Vec<String> = cache
+                .entries
+                .iter()
+                .filter(|(_, c)| c.uploaded)
+                .map(|(n, _)| n.clone())
+                .collect();
             uploads.sort();
             names.extend(uploads);
         }
@@ -151,22 +157,30 @@ impl AppState {
         if let Some(p) = self.cache()?.get(name) {
             return Ok(p);
         }
-        if !continuum::scene::builtin_names(&self.scenes_dir).iter().any(|n| n == name) {
+        if !continuum::scene::builtin_names(&self.scenes_dir)
+            .iter()
+            .any(|n| n == name)
+        {
             return Err(ApiError::bad_request(
                 "scene",
-                format!("unknown scene '{name}'; scenes are: {}", self.scene_names().join(", ")),
+                format!(
+                    "unknown scene '{name}'; scenes are: {}",
+                    self.scene_names().join(", ")
+                ),
             ));
         }
         let scene = continuum::scene::load_named_or_path(name, &self.scenes_dir)
             .map_err(|e| ApiError::internal(format!("scene '{name}' failed to load: {e}")))?;
         let prepared = Arc::new(PreparedScene::new(scene));
-        self.cache()?.insert(name, prepared.clone(), false, self.limits.max_cache_bytes);
+        self.cache()?
+            .insert(name, prepared.clone(), false, self.limits.max_cache_bytes);
         Ok(prepared)
     }
 
     /// Keeps an uploaded, prepared scene under `name`.
     pub fn add_upload(&self, name: &str, scene: Arc<PreparedScene>) -> Result<(), ApiError> {
-        self.cache()?.insert(name, scene, true, self.limits.max_cache_bytes);
+        self.cache()?
+            .insert(name, scene, true, self.limits.max_cache_bytes);
         Ok(())
     }
 

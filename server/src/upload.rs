@@ -4,13 +4,13 @@
 
 use std::sync::Arc;
 
+use axum::Json;
 use axum::body::Bytes;
 use axum::extract::{Query, State};
 use axum::http::StatusCode;
-use axum::Json;
 use continuum::PreparedScene;
 use serde::Deserialize;
-use serde_json::{json, Value};
+use serde_json::{Value, json};
 
 use crate::error::ApiError;
 use crate::state::AppState;
@@ -25,7 +25,8 @@ pub struct UploadQuery {
 
 fn valid_name(n: &str) -> bool {
     (1..=40).contains(&n.len())
-        && n.bytes().all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'-' || b == b'_')
+        && n.bytes()
+            .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'-' || b == b'_')
         && n.as_bytes()[0].is_ascii_alphanumeric()
 }
 
@@ -36,22 +37,32 @@ pub async fn upload(
 ) -> Result<(StatusCode, Json<Value>), ApiError> {
     let Query(query) = query.map_err(|e| {
         let text = e.body_text();
-        let field = crate::render_api::unknown_or_missing_field(&text).unwrap_or_else(|| "name".into());
+        let field =
+            crate::render_api::unknown_or_missing_field(&text).unwrap_or_else(|| "name".into());
         ApiError::bad_request(&field, text)
     })?;
     let body = body.map_err(|e| ApiError::body(&e))?;
     if body.is_empty() {
-        return Err(ApiError::bad_request("file", "the request body must be a .glb file"));
+        return Err(ApiError::bad_request(
+            "file",
+            "the request body must be a .glb file",
+        ));
     }
     let name = match query.name {
         Some(n) if !valid_name(&n) => {
-            return Err(ApiError::bad_request("name", format!("'{n}' is not 1-40 of a-z, 0-9, '-' and '_'")));
+            return Err(ApiError::bad_request(
+                "name",
+                format!("'{n}' is not 1-40 of a-z, 0-9, '-' and '_'"),
+            ));
         }
         Some(n) => n,
         None => format!("upload-{:08x}", fnv1a(&body)),
     };
     if continuum::scene::builtin_names(&state.scenes_dir).contains(&name) {
-        return Err(ApiError::bad_request("name", format!("'{name}' is a built-in scene")));
+        return Err(ApiError::bad_request(
+            "name",
+            format!("'{name}' is a built-in scene"),
+        ));
     }
     let job_state = state.clone();
     let job_name = name.clone();
@@ -63,7 +74,10 @@ pub async fn upload(
             return Err(ApiError::with_status(
                 StatusCode::PAYLOAD_TOO_LARGE,
                 Some("file"),
-                format!("{} triangles exceed the upload limit of {max}", scene.mesh.triangle_count()),
+                format!(
+                    "{} triangles exceed the upload limit of {max}",
+                    scene.mesh.triangle_count()
+                ),
             ));
         }
         let prepared = Arc::new(PreparedScene::new(scene));
@@ -86,5 +100,7 @@ pub async fn upload(
 /// FNV-1a of the file: a short content hash for default upload names.
 fn fnv1a(bytes: &[u8]) -> u32 {
     // FNV-1a: enough to tell uploads apart in a name.
-    bytes.iter().fold(0x811c_9dc5u32, |h, &b| (h ^ u32::from(b)).wrapping_mul(0x0100_0193))
+    bytes.iter().fold(0x811c_9dc5u32, |h, &b| {
+        (h ^ u32::from(b)).wrapping_mul(0x0100_0193)
+    })
 }

@@ -262,11 +262,16 @@ fn upload(state: &Arc<AppState>, query: &str, body: Vec<u8>) -> (StatusCode, ser
             .body(Body::from(body))
             .expect("request"),
     );
-    (status, serde_json::from_slice(&bytes).unwrap_or_else(|_| panic!("JSON body: {}", String::from_utf8_lossy(&bytes))))
+    (
+        status,
+        serde_json::from_slice(&bytes)
+            .unwrap_or_else(|_| panic!("JSON body: {}", String::from_utf8_lossy(&bytes))),
+    )
 }
 
 fn box_glb() -> Vec<u8> {
-    std::fs::read(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes/assets/Box.glb")).expect("Box.glb")
+    std::fs::read(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes/assets/Box.glb"))
+        .expect("Box.glb")
 }
 
 #[test]
@@ -278,24 +283,59 @@ fn uploads_are_validated_kept_and_rendered() {
     });
     let (status, doc) = upload(&s, "?name=my-box", box_glb());
     assert_eq!(status, StatusCode::CREATED, "{doc}");
-    assert_eq!((doc["scene"].as_str(), doc["triangles"].as_u64()), (Some("my-box"), Some(12)));
-    let (status, doc) = post(&s, "/api/render", r#"{ "scene": "my-box", "algorithm": "3dr-full", "size": "32x32" }"#);
+    assert_eq!(
+        (doc["scene"].as_str(), doc["triangles"].as_u64()),
+        (Some("my-box"), Some(12))
+    );
+    let (status, doc) = post(
+        &s,
+        "/api/render",
+        r#"{ "scene": "my-box", "algorithm": "3dr-full", "size": "32x32" }"#,
+    );
     assert_eq!(status, StatusCode::OK, "{doc}");
     let (_, listing) = get(&s, "/api/scenes");
     assert!(String::from_utf8_lossy(&listing).contains("my-box"));
     // A default name from the content.
     let (status, doc) = upload(&s, "", box_glb());
     assert_eq!(status, StatusCode::CREATED, "{doc}");
-    assert!(doc["scene"].as_str().is_some_and(|n| n.starts_with("upload-")));
+    assert!(
+        doc["scene"]
+            .as_str()
+            .is_some_and(|n| n.starts_with("upload-"))
+    );
 
     let cases: Vec<(&str, Vec<u8>, StatusCode, &str)> = vec![
-        ("", b"not a glb at all".to_vec(), StatusCode::BAD_REQUEST, "file"),
+        (
+            "",
+            b"not a glb at all".to_vec(),
+            StatusCode::BAD_REQUEST,
+            "file",
+        ),
         ("", Vec::new(), StatusCode::BAD_REQUEST, "file"),
-        ("?name=Bad%20Name", box_glb(), StatusCode::BAD_REQUEST, "name"),
+        (
+            "?name=Bad%20Name",
+            box_glb(),
+            StatusCode::BAD_REQUEST,
+            "name",
+        ),
         ("?name=bunny", box_glb(), StatusCode::BAD_REQUEST, "name"),
         ("?colour=red", box_glb(), StatusCode::BAD_REQUEST, "colour"),
-        ("", vec![0u8; 100 << 10], StatusCode::PAYLOAD_TOO_LARGE, "body"),
-        ("", std::fs::read(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes/assets/OrientationTest.glb")).expect("glb"), StatusCode::PAYLOAD_TOO_LARGE, "file"),
+        (
+            "",
+            vec![0u8; 100 << 10],
+            StatusCode::PAYLOAD_TOO_LARGE,
+            "body",
+        ),
+        (
+            "",
+            std::fs::read(
+                PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                    .join("../scenes/assets/OrientationTest.glb"),
+            )
+            .expect("glb"),
+            StatusCode::PAYLOAD_TOO_LARGE,
+            "file",
+        ),
     ];
     for (query, body, expected, field) in cases {
         let (status, doc) = upload(&s, query, body);
@@ -310,6 +350,10 @@ fn slow_renders_time_out_with_504() {
         render_timeout: std::time::Duration::from_nanos(1),
         ..Limits::default()
     });
-    let (status, doc) = post(&s, "/api/render", r#"{ "scene": "teapots", "algorithm": "2dr-brute", "size": "640x480" }"#);
+    let (status, doc) = post(
+        &s,
+        "/api/render",
+        r#"{ "scene": "teapots", "algorithm": "2dr-brute", "size": "640x480" }"#,
+    );
     assert_eq!(status, StatusCode::GATEWAY_TIMEOUT, "{doc}");
 }
