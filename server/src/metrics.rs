@@ -99,16 +99,19 @@ impl Metrics {
     }
 }
 
-/// Middleware: counts every request by its matched route and final status.
+/// Middleware: counts every request by its matched route and final status, and
+/// logs it (structured, through `tracing`).
 pub async fn track(State(state): State<Arc<AppState>>, request: Request, next: Next) -> Response {
     let route = request
         .extensions()
         .get::<MatchedPath>()
         .map_or_else(|| "unmatched".to_string(), |p| p.as_str().to_string());
+    let method = request.method().clone();
+    let start = std::time::Instant::now();
     let response = next.run(request).await;
-    state
-        .metrics
-        .count_request(&route, response.status().as_u16());
+    let status = response.status().as_u16();
+    state.metrics.count_request(&route, status);
+    tracing::info!(%method, route, status, ms = start.elapsed().as_secs_f64() * 1e3, "request");
     response
 }
 

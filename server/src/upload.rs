@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use axum::Json;
 use axum::body::Bytes;
-use axum::extract::{Query, State};
+use axum::extract::{Query, Request, State};
 use axum::http::StatusCode;
 use continuum::PreparedScene;
 use serde::Deserialize;
@@ -33,7 +33,7 @@ fn valid_name(n: &str) -> bool {
 pub async fn upload(
     State(state): State<Arc<AppState>>,
     query: Result<Query<UploadQuery>, axum::extract::rejection::QueryRejection>,
-    body: Result<Bytes, axum::extract::rejection::BytesRejection>,
+    request: Request,
 ) -> Result<(StatusCode, Json<Value>), ApiError> {
     let Query(query) = query.map_err(|e| {
         let text = e.body_text();
@@ -41,7 +41,7 @@ pub async fn upload(
             crate::render_api::unknown_or_missing_field(&text).unwrap_or_else(|| "name".into());
         ApiError::bad_request(&field, text)
     })?;
-    let body = body.map_err(|e| ApiError::body(&e))?;
+    let body = read_body(request, state.limits.max_body_bytes).await?;
     if body.is_empty() {
         return Err(ApiError::bad_request(
             "file",
@@ -103,4 +103,30 @@ fn fnv1a(bytes: &[u8]) -> u32 {
     bytes.iter().fold(0x811c_9dc5u32, |h, &b| {
         (h ^ u32::from(b)).wrapping_mul(0x0100_0193)
     })
+}
+
+/// The request body, at most `limit` bytes. A declared `Content-Length` over the
+/// limit is refused before any of the body is read (a client that sent
+/// `Expect: 100-continue` then never sends it).
+async fn read_body(request: Request, limit: usize) -> Result<Bytes, ApiError> {
+    let too_large = |what: String| {
+        ApiError::with_status(
+            StatusCode::PAYLOAD_TOO_LARGE,
+            Some("body"),
+            format!("{what} exceeds the upload limit of {limit} bytes"),
+        )
+    };
+    let declared = request
+        .headers()
+        .get(axum::http::header::CONTENT_LENGTH)
+        .and_then(|v| v.to_str().ok())
+        .and_then(|v| v.parse::<usize>().ok());
+    if let Some(len) = declared
+        && len > limit
+    {
+        return Err(too_large(format!("a body of {len} bytes")));
+    }
+    axum::body::to_bytes(request.into_body(), limit)
+        .await
+        .map_err(|_| too_large("the body".into()))
 }

@@ -1,56 +1,131 @@
 //! The HTTP API: every route, and bad input answered with a 4xx naming the field.
 
-use std::io::{Read, Write};
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::{SocketAddr, TcpStream};
 use std::path::PathBuf;
 use std::sync::Arc;
+use std::time::Duration;
 
-use axum::body::Body;
-use axum::http::{Request, StatusCode};
+use axum::http::StatusCode;
 use continuum_server::{AppState, Limits, app};
-use tower::ServiceExt;
 
-fn state(limits: Limits) -> Arc<AppState> {
-    AppState::new(
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes"),
-        limits,
-    )
+/// The service on a real socket (127.0.0.1, a free port), for one test.
+struct Server {
+    _runtime: tokio::runtime::Runtime,
+    addr: SocketAddr,
+    state: Arc<AppState>,
 }
 
-fn runtime() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_multi_thread()
+fn state(limits: Limits) -> Server {
+    let state = AppState::new(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes"),
+        limits,
+    );
+    let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()
         .build()
-        .expect("runtime")
-}
-
-/// Sends one request through the router; returns status and body bytes.
-fn call(state: &Arc<AppState>, req: Request<Body>) -> (StatusCode, Vec<u8>) {
-    runtime().block_on(async {
-        let res = app(state.clone()).oneshot(req).await.expect("infallible");
-        let status = res.status();
-        let body = axum::body::to_bytes(res.into_body(), 64 << 20)
+        .expect("runtime");
+    let app_state = state.clone();
+    let addr = runtime.block_on(async {
+        let listener = tokio::net::TcpListener::bind("127.0.0.1:0")
             .await
-            .expect("body");
-        (status, body.to_vec())
-    })
+            .expect("bind");
+        let addr = listener.local_addr().expect("addr");
+        tokio::spawn(async move { axum::serve(listener, app(app_state)).await });
+        addr
+    });
+    Server {
+        _runtime: runtime,
+        addr,
+        state,
+    }
 }
 
-fn get(state: &Arc<AppState>, uri: &str) -> (StatusCode, Vec<u8>) {
-    call(
-        state,
-        Request::get(uri).body(Body::empty()).expect("request"),
-    )
+/// One HTTP/1.1 request over a fresh connection. Bodies are announced with
+/// `Expect: 100-continue` and only sent once the server asks for them, as real
+/// clients do for uploads.
+fn http(
+    server: &Server,
+    method: &str,
+    path: &str,
+    content_type: &str,
+    body: &[u8],
+) -> (StatusCode, Vec<u8>) {
+    let mut stream = TcpStream::connect(server.addr).expect("connect");
+    stream
+        .set_read_timeout(Some(Duration::from_secs(120)))
+        .expect("timeout");
+    let mut head = format!("{method} {path} HTTP/1.1\r\nHost: test\r\nConnection: close\r\n");
+    if !body.is_empty() {
+        head.push_str(&format!(
+            "Content-Type: {content_type}\r\nContent-Length: {}\r\nExpect: 100-continue\r\n",
+            body.len()
+        ));
+    }
+    head.push_str("\r\n");
+    stream.write_all(head.as_bytes()).expect("send head");
+    let mut reader = BufReader::new(stream.try_clone().expect("clone"));
+    let mut status_line = String::new();
+    reader.read_line(&mut status_line).expect("status line");
+    if status_line.starts_with("HTTP/1.1 100") {
+        let mut blank = String::new();
+        reader.read_line(&mut blank).expect("blank line");
+        stream.write_all(body).expect("send body");
+        status_line.clear();
+        reader.read_line(&mut status_line).expect("status line");
+    }
+    let code: u16 = status_line
+        .split_whitespace()
+        .nth(1)
+        .and_then(|c| c.parse().ok())
+        .expect("status code");
+    let mut headers = Vec::new();
+    loop {
+        let mut line = String::new();
+        reader.read_line(&mut line).expect("header");
+        if line == "\r\n" || line.is_empty() {
+            break;
+        }
+        headers.push(line.to_ascii_lowercase());
+    }
+    let mut rest = Vec::new();
+    reader.read_to_end(&mut rest).expect("body");
+    let body = if headers
+        .iter()
+        .any(|h| h.starts_with("transfer-encoding: chunked"))
+    {
+        dechunk(&rest)
+    } else {
+        rest
+    };
+    (StatusCode::from_u16(code).expect("status"), body)
 }
 
-fn post(state: &Arc<AppState>, uri: &str, body: &str) -> (StatusCode, serde_json::Value) {
-    let (status, bytes) = call(
-        state,
-        Request::post(uri)
-            .header("content-type", "application/json")
-            .body(Body::from(body.to_string()))
-            .expect("request"),
-    );
+fn dechunk(mut data: &[u8]) -> Vec<u8> {
+    let mut out = Vec::new();
+    loop {
+        let end = data
+            .windows(2)
+            .position(|w| w == b"\r\n")
+            .expect("chunk size line");
+        let size =
+            usize::from_str_radix(std::str::from_utf8(&data[..end]).expect("hex").trim(), 16)
+                .expect("chunk size");
+        if size == 0 {
+            return out;
+        }
+        out.extend_from_slice(&data[end + 2..end + 2 + size]);
+        data = &data[end + 2 + size + 2..];
+    }
+}
+
+fn get(server: &Server, uri: &str) -> (StatusCode, Vec<u8>) {
+    http(server, "GET", uri, "", b"")
+}
+
+fn post(server: &Server, uri: &str, body: &str) -> (StatusCode, serde_json::Value) {
+    let (status, bytes) = http(server, "POST", uri, "application/json", body.as_bytes());
     (
         status,
         serde_json::from_slice(&bytes)
@@ -210,7 +285,11 @@ fn overload_answers_503_and_the_server_keeps_serving() {
         ..Limits::default()
     });
     // Hold the only render slot, as a long render would.
-    let held = s.renders_for_test().try_acquire_owned().expect("free slot");
+    let held = s
+        .state
+        .renders_for_test()
+        .try_acquire_owned()
+        .expect("free slot");
     let (status, doc) = post(
         &s,
         "/api/render",
@@ -226,41 +305,13 @@ fn overload_answers_503_and_the_server_keeps_serving() {
     assert_eq!(status, StatusCode::OK, "{doc}");
 }
 
-#[test]
-fn serves_over_a_real_socket() {
-    let rt = runtime();
-    let s = state(Limits::default());
-    let addr = rt.block_on(async {
-        let listener = tokio::net::TcpListener::bind("127.0.0.1:0")
-            .await
-            .expect("bind");
-        let addr = listener.local_addr().expect("addr");
-        tokio::spawn(async move { axum::serve(listener, app(s)).await });
-        addr
-    });
-    let mut stream = std::net::TcpStream::connect(addr).expect("connect");
-    stream
-        .write_all(b"GET /api/render.png?scene=sphere&algorithm=3dr-brute&size=40x30 HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n")
-        .expect("send");
-    let mut response = Vec::new();
-    stream.read_to_end(&mut response).expect("read");
-    let text = String::from_utf8_lossy(&response);
-    assert!(
-        text.starts_with("HTTP/1.1 200"),
-        "{}",
-        &text[..text.len().min(200)]
-    );
-    assert!(text.contains("content-type: image/png"));
-    assert!(response.windows(4).any(|w| w == b"\x89PNG"));
-}
-
-fn upload(state: &Arc<AppState>, query: &str, body: Vec<u8>) -> (StatusCode, serde_json::Value) {
-    let (status, bytes) = call(
-        state,
-        Request::post(format!("/api/scenes{query}"))
-            .header("content-type", "model/gltf-binary")
-            .body(Body::from(body))
-            .expect("request"),
+fn upload(server: &Server, query: &str, body: Vec<u8>) -> (StatusCode, serde_json::Value) {
+    let (status, bytes) = http(
+        server,
+        "POST",
+        &format!("/api/scenes{query}"),
+        "model/gltf-binary",
+        &body,
     );
     (
         status,
