@@ -305,13 +305,13 @@ fn overload_answers_503_and_the_server_keeps_serving() {
     assert_eq!(status, StatusCode::OK, "{doc}");
 }
 
-fn upload(server: &Server, query: &str, body: Vec<u8>) -> (StatusCode, serde_json::Value) {
+fn upload(server: &Server, query: &str, body: &[u8]) -> (StatusCode, serde_json::Value) {
     let (status, bytes) = http(
         server,
         "POST",
         &format!("/api/scenes{query}"),
         "model/gltf-binary",
-        &body,
+        body,
     );
     (
         status,
@@ -332,7 +332,7 @@ fn uploads_are_validated_kept_and_rendered() {
         max_upload_triangles: 100,
         ..Limits::default()
     });
-    let (status, doc) = upload(&s, "?name=my-box", box_glb());
+    let (status, doc) = upload(&s, "?name=my-box", &box_glb());
     assert_eq!(status, StatusCode::CREATED, "{doc}");
     assert_eq!(
         (doc["scene"].as_str(), doc["triangles"].as_u64()),
@@ -347,7 +347,7 @@ fn uploads_are_validated_kept_and_rendered() {
     let (_, listing) = get(&s, "/api/scenes");
     assert!(String::from_utf8_lossy(&listing).contains("my-box"));
     // A default name from the content.
-    let (status, doc) = upload(&s, "", box_glb());
+    let (status, doc) = upload(&s, "", &box_glb());
     assert_eq!(status, StatusCode::CREATED, "{doc}");
     assert!(
         doc["scene"]
@@ -389,7 +389,7 @@ fn uploads_are_validated_kept_and_rendered() {
         ),
     ];
     for (query, body, expected, field) in cases {
-        let (status, doc) = upload(&s, query, body);
+        let (status, doc) = upload(&s, query, &body);
         assert_eq!(status, expected, "{query}: {doc}");
         assert_eq!(doc["field"], field, "{query}: {doc}");
     }
