@@ -50,7 +50,13 @@ impl Metrics {
         }
     }
 
-    fn render_text(&self, in_flight: usize, cached: usize, cached_bytes: usize) -> String {
+    fn render_text(
+        &self,
+        in_flight: usize,
+        queued: usize,
+        cached: usize,
+        cached_bytes: usize,
+    ) -> String {
         let mut out = String::new();
         out.push_str("# HELP continuum_requests_total HTTP requests by route and status.\n");
         out.push_str("# TYPE continuum_requests_total counter\n");
@@ -91,6 +97,8 @@ impl Metrics {
         }
         out.push_str("# HELP continuum_renders_in_flight Renders running now.\n# TYPE continuum_renders_in_flight gauge\n");
         let _ = writeln!(out, "continuum_renders_in_flight {in_flight}");
+        out.push_str("# HELP continuum_render_queue_depth Renders waiting for a slot.\n# TYPE continuum_render_queue_depth gauge\n");
+        let _ = writeln!(out, "continuum_render_queue_depth {queued}");
         out.push_str("# HELP continuum_scene_cache_size Prepared scenes held in memory.\n# TYPE continuum_scene_cache_size gauge\n");
         let _ = writeln!(out, "continuum_scene_cache_size {cached}");
         out.push_str("# HELP continuum_scene_cache_bytes Approximate memory of the cached scenes.\n# TYPE continuum_scene_cache_bytes gauge\n");
@@ -124,6 +132,11 @@ pub async fn metrics(State(state): State<Arc<AppState>>) -> impl IntoResponse {
             axum::http::header::CONTENT_TYPE,
             "text/plain; version=0.0.4",
         )],
-        state.metrics.render_text(in_flight, cached, bytes),
+        state.metrics.render_text(
+            in_flight,
+            state.queued.load(std::sync::atomic::Ordering::SeqCst),
+            cached,
+            bytes,
+        ),
     )
 }

@@ -103,15 +103,21 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
     })
 }
 
-/// Renders on the blocking pool, at most `max_concurrent_renders` at once.
+/// Renders on the blocking pool, at most `max_concurrent_renders` at once; up to
+/// `max_queued_renders` more wait for a slot, and beyond that the answer is 503.
 async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, String), ApiError> {
-    let permit = state
-        .renders
-        .clone()
-        .try_acquire_owned()
-        .map_err(|_| ApiError::overloaded())?;
-    let job_state = state.clone();
     let timeout = state.limits.render_timeout;
+    let permit = match state.renders.clone().try_acquire_owned() {
+        Ok(p) => p,
+        Err(_) => {
+            let _ticket = state.queue_ticket().ok_or_else(ApiError::overloaded)?;
+            let wait = tokio::time::timeout(timeout, state.renders.clone().acquire_owned());
+            wait.await
+                .map_err(|_| ApiError::overloaded())?
+                .map_err(|_| ApiError::internal("render slots closed"))?
+        }
+    };
+    let job_state = state.clone();
     let job = tokio::task::spawn_blocking(move || {
         let _permit = permit;
         let prepared = job_state.prepared(&c.scene)?;

@@ -20,9 +20,12 @@ pub struct ServeArgs {
     /// Most pixels in one render [default: 4096000].
     #[arg(long)]
     pub max_pixels: Option<u64>,
-    /// Renders running at once; more are answered 503 [default: cores].
+    /// Renders running at once [default: cores].
     #[arg(long)]
     pub max_concurrent: Option<usize>,
+    /// Renders that may wait for a slot; more are answered 503 [default: 4 × cores].
+    #[arg(long)]
+    pub max_queued: Option<usize>,
     /// Seconds before a render is answered 504 [default: 60].
     #[arg(long)]
     pub render_timeout: Option<f64>,
@@ -55,6 +58,9 @@ impl ServeArgs {
         if let Some(v) = self.max_concurrent {
             positive("max-concurrent", v > 0)?;
             l.max_concurrent_renders = v;
+        }
+        if let Some(v) = self.max_queued {
+            l.max_queued_renders = v;
         }
         if let Some(v) = self.render_timeout {
             positive("render-timeout", v > 0.0 && v.is_finite())?;

@@ -19,8 +19,10 @@ pub struct Limits {
     pub max_pixels: u64,
     /// Most samples per pixel a request may ask for (anti-aliasing modes).
     pub max_samples_per_pixel: u32,
-    /// Renders running at once; more get 503.
+    /// Renders running at once.
     pub max_concurrent_renders: usize,
+    /// Renders that may wait for a slot; more get 503 with `Retry-After`.
+    pub max_queued_renders: usize,
     /// A render not finished by then is answered with 504 (it still completes).
     pub render_timeout: Duration,
     /// Largest request body (JSON requests and `.glb` uploads), bytes.
@@ -37,6 +39,7 @@ impl Default for Limits {
             max_pixels: 2560 * 1600,
             max_samples_per_pixel: 1,
             max_concurrent_renders: std::thread::available_parallelism().map_or(2, |n| n.get()),
+            max_queued_renders: 4 * std::thread::available_parallelism().map_or(2, |n| n.get()),
             render_timeout: Duration::from_secs(60),
             max_body_bytes: 32 << 20,
             max_upload_triangles: 2_000_000,
@@ -106,7 +109,19 @@ pub struct AppState {
     pub limits: Limits,
     pub(crate) renders: Arc<Semaphore>,
     pub(crate) metrics: crate::metrics::Metrics,
+    /// Requests waiting for a render slot.
+    pub(crate) queued: std::sync::atomic::AtomicUsize,
     cache: Mutex<Cache>,
+}
+
+/// A place in the render queue, given back when dropped.
+#[derive(Debug)]
+pub(crate) struct QueueTicket<'a>(&'a std::sync::atomic::AtomicUsize);
+
+impl Drop for QueueTicket<'_> {
+    fn drop(&mut self) {
+        self.0.fetch_sub(1, std::sync::atomic::Ordering::SeqCst);
+    }
 }
 
 impl AppState {
@@ -116,8 +131,21 @@ impl AppState {
             renders: Arc::new(Semaphore::new(limits.max_concurrent_renders.max(1))),
             limits,
             metrics: crate::metrics::Metrics::default(),
+            queued: std::sync::atomic::AtomicUsize::new(0),
             cache: Mutex::new(Cache::default()),
         })
+    }
+
+    /// A place in the render queue, or `None` when it is full.
+    pub(crate) fn queue_ticket(&self) -> Option<QueueTicket<'_>> {
+        use std::sync::atomic::Ordering;
+        let max = self.limits.max_queued_renders;
+        self.queued
+            .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |n| {
+                (n < max).then_some(n + 1)
+            })
+            .ok()
+            .map(|_| QueueTicket(&self.queued))
     }
 
     fn cache(&self) -> Result<std::sync::MutexGuard<'_, Cache>, ApiError> {

@@ -177,6 +177,7 @@ fn web_page_and_metrics() {
         "continuum_requests_total{route=\"/api/render.png\",status=\"400\"} 1",
         "continuum_render_seconds_count{algorithm=\"3dr-full\"} 1",
         "continuum_renders_in_flight 0",
+        "continuum_render_queue_depth 0",
         "continuum_scene_cache_size 1",
     ] {
         assert!(text.contains(line), "missing {line} in\n{text}");
@@ -279,9 +280,46 @@ fn bad_input_is_a_4xx_naming_the_field() {
 }
 
 #[test]
+fn a_full_queue_answers_503_and_queued_renders_wait_their_turn() {
+    let s = Arc::new(state(Limits {
+        max_concurrent_renders: 1,
+        max_queued_renders: 1,
+        ..Limits::default()
+    }));
+    let held = s
+        .state
+        .renders_for_test()
+        .try_acquire_owned()
+        .expect("free slot");
+    let body = r#"{ "scene": "box", "algorithm": "raycast", "size": "16x16" }"#;
+    let queued = {
+        let s = s.clone();
+        std::thread::spawn(move || post(&s, "/api/render", body).0)
+    };
+    // Wait until that request is in the queue, then one more is refused.
+    let start = std::time::Instant::now();
+    loop {
+        let (_, text) = get(&s, "/metrics");
+        if String::from_utf8_lossy(&text).contains("continuum_render_queue_depth 1") {
+            break;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(30),
+            "the request never queued"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let (status, doc) = post(&s, "/api/render", body);
+    assert_eq!(status, StatusCode::SERVICE_UNAVAILABLE, "{doc}");
+    drop(held);
+    assert_eq!(queued.join().expect("queued request"), StatusCode::OK);
+}
+
+#[test]
 fn overload_answers_503_and_the_server_keeps_serving() {
     let s = state(Limits {
         max_concurrent_renders: 1,
+        max_queued_renders: 0,
         ..Limits::default()
     });
     // Hold the only render slot, as a long render would.
