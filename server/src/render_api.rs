@@ -261,6 +261,8 @@ pub async fn scenes(State(state): State<Arc<AppState>>) -> Result<Json<Value>, A
                         "triangles": p.triangle_count(),
                         "cameras": cameras,
                         "lights": p.scene.lights.len(),
+                        // What the scene calls for; shading runs Lambert only so far.
+                        "effects": p.scene.effects(),
                         "warnings": p.scene.warnings,
                     })
                 }

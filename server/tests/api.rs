@@ -150,6 +150,24 @@ fn listings() {
         .iter()
         .filter_map(|a| a["id"].as_str())
         .collect();
+    let (status, body) = get(&s, "/api/scenes");
+    assert_eq!(status, StatusCode::OK);
+    let doc: serde_json::Value = serde_json::from_slice(&body).expect("json");
+    let bunny = doc["scenes"]
+        .as_array()
+        .expect("list")
+        .iter()
+        .find(|s| s["name"] == "bunny")
+        .expect("bunny");
+    assert_eq!(bunny["triangles"], 69_451);
+    assert!(
+        bunny["cameras"]
+            .as_array()
+            .expect("cameras")
+            .iter()
+            .any(|c| c["name"] == "front" && c["eye"].is_array())
+    );
+    assert!(bunny["effects"].is_array());
     let expected: Vec<&str> = continuum::AlgorithmId::ALL
         .iter()
         .map(|a| a.as_str())
