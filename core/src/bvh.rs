@@ -66,6 +66,18 @@ fn decode_children(node: &CwBvhNode) -> ChildBoxes {
     boxes
 }
 
+/// The padded box of each drawable triangle: the BVH's primitives.
+fn primitive_aabbs(triangles: &[[Vec3; 3]], drawable: &[u32]) -> Vec<Aabb> {
+    drawable
+        .iter()
+        .map(|&id| {
+            let [a, b, c] = triangles[id as usize];
+            let (min, max) = padded(Vec3A::from(a.min(b).min(c)), Vec3A::from(a.max(b).max(c)));
+            Aabb::new(min, max)
+        })
+        .collect()
+}
+
 /// Pads a box by [`BOX_PAD`] of its largest coordinate magnitude (plus a tiny
 /// absolute amount for boxes at the origin).
 #[inline]
@@ -78,14 +90,7 @@ impl SceneBvh {
     /// Builds over `triangles[id]` for every `id` in `drawable`.
     pub fn build(triangles: &[[Vec3; 3]], drawable: &[u32]) -> SceneBvh {
         let start = Instant::now();
-        let aabbs: Vec<Aabb> = drawable
-            .iter()
-            .map(|&id| {
-                let [a, b, c] = triangles[id as usize];
-                let (min, max) = padded(Vec3A::from(a.min(b).min(c)), Vec3A::from(a.max(b).max(c)));
-                Aabb::new(min, max)
-            })
-            .collect();
+        let aabbs = primitive_aabbs(triangles, drawable);
         let cwbvh = if aabbs.is_empty() {
             CwBvh::default()
         } else {
@@ -110,14 +115,7 @@ impl SceneBvh {
             assert!(drawable.is_empty());
             return;
         }
-        let aabbs: Vec<Aabb> = drawable
-            .iter()
-            .map(|&id| {
-                let [a, b, c] = triangles[id as usize];
-                let (min, max) = padded(Vec3A::from(a.min(b).min(c)), Vec3A::from(a.max(b).max(c)));
-                Aabb::new(min, max)
-            })
-            .collect();
+        let aabbs = primitive_aabbs(triangles, drawable);
         let result = self.cwbvh.validate(&aabbs, false);
         assert_eq!(
             result.prim_count,

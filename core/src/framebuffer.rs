@@ -82,18 +82,6 @@ impl Band<'_> {
     pub fn index(&self, x: u32, y: u32) -> usize {
         (y - self.y0) as usize * self.width as usize + x as usize
     }
-
-    /// A covered sample: count the coverage write, then the w-buffer test. Depth
-    /// ties go to the smaller triangle id, so no result depends on drawing order.
-    #[inline(always)]
-    pub fn write(&mut self, i: usize, w: f32, id: u32) {
-        self.coverage_writes[i] += 1;
-        let (d, t) = (self.depth[i], self.triangle_id[i]);
-        if w < d || (w == d && id < t) {
-            self.depth[i] = w;
-            self.triangle_id[i] = id;
-        }
-    }
 }
 
 /// Side of a hierarchical w-buffer cell in pixels.

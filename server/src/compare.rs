@@ -118,6 +118,51 @@ struct Row {
     pixels_differing_from_3dr_brute: Option<u64>,
 }
 
+impl Row {
+    /// A row from timed repetitions (median, min, max, rays per second); the
+    /// relations to other rows are filled in later.
+    fn timed(
+        scene: &str,
+        algorithm: &str,
+        (width, height): (u32, u32),
+        threads: usize,
+        times: Vec<f64>,
+    ) -> Row {
+        let (median_ms, min_ms, max_ms) = median(times);
+        Row {
+            scene: scene.to_string(),
+            algorithm: algorithm.to_string(),
+            viewport: String::new(),
+            aa: String::new(),
+            width,
+            height,
+            threads,
+            median_ms,
+            min_ms,
+            max_ms,
+            ratio_to_2dr_brute: None,
+            predicted_ratio: None,
+            rays_per_second: f64::from(width) * f64::from(height) / (median_ms / 1e3),
+            stats: Value::Null,
+            hashes: Value::Null,
+            agrees: false,
+            pixels_differing_from_3dr_brute: None,
+        }
+    }
+
+    fn with(mut self, viewport: &str, aa: &str, stats: Value) -> Row {
+        self.viewport = viewport.to_string();
+        self.aa = aa.to_string();
+        self.stats = stats;
+        self
+    }
+
+    fn hashes(mut self, hashes: Value) -> Row {
+        self.hashes = hashes;
+        self
+    }
+}
+
 fn median(mut v: Vec<f64>) -> (f64, f64, f64) {
     v.sort_by(f64::total_cmp);
     let n = v.len();
@@ -236,27 +281,19 @@ fn measure_algorithm(
             .map_err(|e| CliError::Usage(format!("--{e}")))?;
         times.push(out.stats.time_ms.total);
     }
-    let (median_ms, min_ms, max_ms) = median(times);
-    let pixels = f64::from(args.size.0) * f64::from(args.size.1);
-    let row = Row {
-        scene: scene.to_string(),
-        algorithm: algorithm.as_str().into(),
-        viewport: out.viewport.clone(),
-        aa: out.aa.clone(),
-        width: args.size.0,
-        height: args.size.1,
+    let row = Row::timed(
+        scene,
+        algorithm.as_str(),
+        (args.size.0, args.size.1),
         threads,
-        median_ms,
-        min_ms,
-        max_ms,
-        ratio_to_2dr_brute: None,
-        predicted_ratio: None,
-        rays_per_second: pixels / (median_ms / 1e3),
-        stats: serde_json::to_value(&out.stats).unwrap_or(Value::Null),
-        hashes: serde_json::to_value(&out.hashes).unwrap_or(Value::Null),
-        agrees: true,
-        pixels_differing_from_3dr_brute: None,
-    };
+        times,
+    )
+    .with(
+        &out.viewport,
+        &out.aa,
+        serde_json::to_value(&out.stats).unwrap_or(Value::Null),
+    )
+    .hashes(serde_json::to_value(&out.hashes).unwrap_or(Value::Null));
     Ok((row, out.framebuffer.triangle_id))
 }
 
@@ -272,27 +309,18 @@ fn measure_peer(
     let run = pool
         .install(|| run_peer(peer, prepared, view, repeat))
         .map_err(|e| CliError::Usage(format!("--algorithms: {e}")))?;
-    let (median_ms, min_ms, max_ms) = median(run.times_ms);
-    let pixels = f64::from(view.width) * f64::from(view.height);
-    let row = Row {
-        scene: scene.to_string(),
-        algorithm: peer.as_str().into(),
-        viewport: "perspective".into(),
-        aa: "none".into(),
-        width: view.width,
-        height: view.height,
+    let row = Row::timed(
+        scene,
+        peer.as_str(),
+        (view.width, view.height),
         threads,
-        median_ms,
-        min_ms,
-        max_ms,
-        ratio_to_2dr_brute: None,
-        predicted_ratio: None,
-        rays_per_second: pixels / (median_ms / 1e3),
-        stats: json!({ "bvh_build_ms": run.build_ms }),
-        hashes: Value::Null,
-        agrees: false,
-        pixels_differing_from_3dr_brute: None,
-    };
+        run.times_ms,
+    )
+    .with(
+        "perspective",
+        "none",
+        json!({ "bvh_build_ms": run.build_ms }),
+    );
     Ok((row, run.triangle_id))
 }
 

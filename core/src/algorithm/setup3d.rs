@@ -9,32 +9,25 @@ use super::PixelRect;
 use super::tiles::Placed;
 use crate::camera::View;
 use crate::clip::{ClipPlane, clip_triangle};
-use crate::edge::{Triangle3D, TriangleHomogeneous};
+use crate::edge::{self, Triangle3D};
 use crate::prepared::PreparedScene;
 
 /// Every drawable triangle with samples on screen, set up with 3D edge functions.
 pub(crate) fn setup_3d(scene: &PreparedScene, view: &View) -> Vec<Placed<Triangle3D>> {
-    scene
-        .drawable
-        .par_iter()
-        .filter_map(|&id| {
-            let p = &scene.triangles[id as usize];
-            let rect = screen_rect(p, view)?;
-            Some(Placed {
-                tri: Triangle3D::setup(p, view)?,
-                rect,
-                id,
-            })
-        })
-        .collect()
+    setup_visible(scene, view, Triangle3D::setup)
 }
 
 /// Every drawable triangle with samples on screen, set up for homogeneous 2D
 /// rasterization (no clipping).
-pub(crate) fn setup_homogeneous(
+pub(crate) fn setup_homogeneous(scene: &PreparedScene, view: &View) -> Vec<Placed<Triangle3D>> {
+    setup_visible(scene, view, edge::setup_homogeneous)
+}
+
+fn setup_visible(
     scene: &PreparedScene,
     view: &View,
-) -> Vec<Placed<TriangleHomogeneous>> {
+    setup: impl Fn(&[Vec3; 3], &View) -> Option<Triangle3D> + Sync,
+) -> Vec<Placed<Triangle3D>> {
     scene
         .drawable
         .par_iter()
@@ -42,7 +35,7 @@ pub(crate) fn setup_homogeneous(
             let p = &scene.triangles[id as usize];
             let rect = screen_rect(p, view)?;
             Some(Placed {
-                tri: TriangleHomogeneous::setup(p, view)?,
+                tri: setup(p, view)?,
                 rect,
                 id,
             })

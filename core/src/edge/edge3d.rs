@@ -55,6 +55,9 @@ pub fn edge_normal(eye: Vec3, a: Vec3, b: Vec3) -> Vec3 {
     (eye - mid).cross(a - b)
 }
 
+/// Linear functions of the image point, `k[0] + x·k[1] + y·k[2]`.
+pub type Linear = [f32; 3];
+
 impl Triangle3D {
     /// Paper §3.2 setup: three edge normals, their derivatives along the sample
     /// generator, and the triangle's volume as seen from the eye. `None` when the
@@ -70,47 +73,50 @@ impl Triangle3D {
             return None;
         }
         let sign = if d > 0.0 { 1.0 } else { -1.0 };
+        let along = |n: Vec3| [n.dot(view.d0), n.dot(view.dx), n.dot(view.dy)];
         // 2. Edge i is opposite vertex i: (p[i+1], p[i+2]).
-        let mut t = Triangle3D {
-            a: [0.0; 3],
-            b: [0.0; 3],
-            c: [0.0; 3],
-            volume: d.abs(),
-            nd: [
-                sign * normal.dot(view.d0),
-                sign * normal.dot(view.dx),
-                sign * normal.dot(view.dy),
-            ],
-            owns: [false; 3],
-            w_range: [0.0; 2],
-            near: view.near,
-            error: [0.0; 3],
-        };
+        let edges =
+            [0, 1, 2].map(|i| along(edge_normal(eye, p[(i + 1) % 3], p[(i + 2) % 3]) * sign));
         let w = p.map(|v| (v - eye).dot(view.forward));
-        t.w_range = [w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2])];
+        Triangle3D::from_linear(edges, along(normal * sign), d.abs(), w, view)
+    }
+
+    /// Assembles a triangle from its three sign-normalised edge functions, the
+    /// depth denominator `N·d` (so `w = volume / (N·d)`), and its vertices' `w`:
+    /// derives the tie rule and the error bounds. `None` on non-finite values.
+    pub fn from_linear(
+        edges: [Linear; 3],
+        nd: Linear,
+        volume: f32,
+        vertex_w: [f32; 3],
+        view: &View,
+    ) -> Option<Triangle3D> {
         let (x_max, y_max) = (view.width as f32, view.height as f32);
-        for i in 0..3 {
-            let n = edge_normal(eye, p[(i + 1) % 3], p[(i + 2) % 3]) * sign;
-            t.a[i] = n.dot(view.d0);
-            t.b[i] = n.dot(view.dx);
-            t.c[i] = n.dot(view.dy);
-            t.owns[i] = owns_tie(t.b[i], t.c[i]);
+        let t = Triangle3D {
+            a: edges.map(|e| e[0]),
+            b: edges.map(|e| e[1]),
+            c: edges.map(|e| e[2]),
+            nd,
+            volume,
+            owns: edges.map(|e| owns_tie(e[1], e[2])),
+            w_range: [
+                vertex_w[0].min(vertex_w[1]).min(vertex_w[2]),
+                vertex_w[0].max(vertex_w[1]).max(vertex_w[2]),
+            ],
+            near: view.near,
             // (A + x·B) + y·C rounds four times, each by at most 2⁻²⁴ of the sum of
             // the terms' magnitudes; 2⁻²⁰ leaves a factor-4 margin.
-            t.error[i] = (t.a[i].abs() + x_max * t.b[i].abs() + y_max * t.c[i].abs())
-                * (1.0 / (1 << 20) as f32);
-        }
-        if !(t
-            .a
+            error: edges.map(|e| {
+                (e[0].abs() + x_max * e[1].abs() + y_max * e[2].abs()) * (1.0 / (1 << 20) as f32)
+            }),
+        };
+        let finite = edges
             .iter()
-            .chain(&t.b)
-            .chain(&t.c)
-            .chain(&t.nd)
-            .all(|v| v.is_finite()))
-        {
-            return None;
-        }
-        Some(t)
+            .flatten()
+            .chain(&nd)
+            .chain(&[volume])
+            .all(|v| v.is_finite());
+        finite.then_some(t)
     }
 }
 

@@ -13,7 +13,7 @@ mod homogeneous;
 
 pub use edge2d::{ScreenVertex, Triangle2D};
 pub use edge3d::Triangle3D;
-pub use homogeneous::TriangleHomogeneous;
+pub use homogeneous::setup_homogeneous;
 
 /// The tie rule of paper §3.4 (Direct3D's top-left rule written with derivatives):
 /// a sample on an edge (`E = 0`) belongs to the triangle whose edge function grows
