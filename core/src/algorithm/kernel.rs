@@ -100,7 +100,23 @@ fn early_z_rejects<T: Coverage>(
 fn test_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRect) {
     for y in r.y0..=r.y1 {
         let yc = pixel_center(y);
-        for x in r.x0..=r.x1 {
+        let mut x = r.x0;
+        // Eight samples at a time, then the rest one by one.
+        while x + 7 <= r.x1 {
+            let (mask, depth) = tri.sample8(pixel_center(x), yc);
+            let i = tile.index(x, y);
+            for count in &mut tile.edge_evals[i..i + 8] {
+                *count += 1;
+            }
+            let mut covered = mask;
+            while covered != 0 {
+                let k = covered.trailing_zeros() as usize;
+                covered &= covered - 1;
+                tile.write(i + k, depth[k], id);
+            }
+            x += 8;
+        }
+        for x in x..=r.x1 {
             let i = tile.index(x, y);
             tile.edge_evals[i] += 1;
             if let Some(w) = tri.sample(pixel_center(x), yc) {

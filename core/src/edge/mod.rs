@@ -54,6 +54,23 @@ pub trait Coverage {
     /// No sample of the triangle has a smaller depth than this.
     fn min_depth(&self) -> f32;
 
+    /// Coverage and depth of eight samples in a row, at `x0, x0 + 1, …, x0 + 7`:
+    /// a bit mask of the covered ones and their depths. Bit for bit what
+    /// [`Coverage::sample`] gives for each (implementations that vectorise it
+    /// must round alike: no fused multiply-add, the same operation order).
+    #[inline(always)]
+    fn sample8(&self, x0: f32, y: f32) -> (u8, [f32; 8]) {
+        let mut mask = 0;
+        let mut depth = [0.0; 8];
+        for (k, d) in depth.iter_mut().enumerate() {
+            if let Some(w) = self.sample(x0 + k as f32, y) {
+                mask |= 1 << k;
+                *d = w;
+            }
+        }
+        (mask, depth)
+    }
+
     /// Coverage and depth of the sample at `(x, y)`.
     #[inline(always)]
     fn sample(&self, x: f32, y: f32) -> Option<f32> {
