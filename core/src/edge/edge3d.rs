@@ -169,11 +169,11 @@ impl Coverage for Triangle3D {
             } else {
                 zero.simd_ne(zero)
             };
-            inside = inside & (e.simd_gt(zero) | on_edge);
+            inside &= e.simd_gt(zero) | on_edge;
         }
         let facing =
             f32x8::splat(self.nd[0]) + x * f32x8::splat(self.nd[1]) + y * f32x8::splat(self.nd[2]);
-        inside = inside & facing.simd_gt(zero);
+        inside &= facing.simd_gt(zero);
         let mask = inside.to_bitmask() as u8;
         if mask == 0 {
             return (0, [0.0; 8]);
