@@ -226,9 +226,9 @@ mod tests {
                 let yc = y as f32 + 0.5;
                 for x0 in (0..64).step_by(8) {
                     let (mask, depth) = t.sample8(x0 as f32 + 0.5, yc);
-                    for k in 0..8 {
+                    for (k, &lane_depth) in depth.iter().enumerate() {
                         let scalar = t.sample((x0 + k) as f32 + 0.5, yc);
-                        let lane = (mask >> k & 1 == 1).then_some(depth[k]);
+                        let lane = (mask >> k & 1 == 1).then_some(lane_depth);
                         assert_eq!(
                             scalar.map(f32::to_bits),
                             lane.map(f32::to_bits),
