@@ -76,6 +76,18 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
         .transpose()?
         .flatten();
     body.aa.as_deref().map(parse_aa).transpose()?;
+    // Every mode that exists so far takes one sample per pixel.
+    let samples_per_pixel = 1;
+    if samples_per_pixel > state.limits.max_samples_per_pixel {
+        return Err(FieldError::new(
+            "aa",
+            format!(
+                "{samples_per_pixel} samples per pixel exceed the limit of {}",
+                state.limits.max_samples_per_pixel
+            ),
+        )
+        .into());
+    }
     if let Some(bad) = body
         .outputs
         .iter()

@@ -23,6 +23,9 @@ pub struct ServeArgs {
     /// Renders running at once [default: cores].
     #[arg(long)]
     pub max_concurrent: Option<usize>,
+    /// Most samples per pixel an anti-aliasing mode may take [default: 256].
+    #[arg(long)]
+    pub max_samples_per_pixel: Option<u32>,
     /// Renders that may wait for a slot; more are answered 503 [default: 4 × cores].
     #[arg(long)]
     pub max_queued: Option<usize>,
@@ -58,6 +61,10 @@ impl ServeArgs {
         if let Some(v) = self.max_concurrent {
             positive("max-concurrent", v > 0)?;
             l.max_concurrent_renders = v;
+        }
+        if let Some(v) = self.max_samples_per_pixel {
+            positive("max-samples-per-pixel", v > 0)?;
+            l.max_samples_per_pixel = v;
         }
         if let Some(v) = self.max_queued {
             l.max_queued_renders = v;

@@ -37,7 +37,7 @@ impl Default for Limits {
     fn default() -> Self {
         Limits {
             max_pixels: 2560 * 1600,
-            max_samples_per_pixel: 1,
+            max_samples_per_pixel: 256,
             max_concurrent_renders: std::thread::available_parallelism().map_or(2, |n| n.get()),
             max_queued_renders: 4 * std::thread::available_parallelism().map_or(2, |n| n.get()),
             render_timeout: Duration::from_secs(60),

@@ -257,6 +257,10 @@ fn bad_input_is_a_4xx_naming_the_field() {
             "size",
         ),
         (
+            r#"{ "scene": "box", "algorithm": "raycast", "viewport": "orthographic:10" }"#,
+            "viewport",
+        ),
+        (
             r#"{ "scene": "box", "algorithm": "raycast", "viewport": "fisheye" }"#,
             "viewport",
         ),
