@@ -15,6 +15,7 @@
 //! ```
 
 pub mod algorithm;
+pub mod binning;
 pub mod bvh;
 pub mod camera;
 pub mod clip;

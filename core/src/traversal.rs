@@ -15,8 +15,8 @@
 use glam::{Vec3, Vec3A};
 
 use crate::algorithm::PixelRect;
-use crate::algorithm::kernel::{SampleOracles, raster_triangle};
 use crate::algorithm::setup3d::screen_rect;
+use crate::binning::{SampleOracles, raster_triangle};
 use crate::bvh::{SlabRay, padded};
 use crate::camera::View;
 use crate::edge::Triangle3D;

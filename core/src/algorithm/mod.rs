@@ -12,7 +12,6 @@
 //! | `3dr-full` | as split | binning + early-z at leaves |
 //! | `raycast` | CWBVH walked per ray | one sample per ray, the same 3D edges |
 
-pub(crate) mod kernel;
 mod raycast;
 pub(crate) mod setup2d;
 pub(crate) mod setup3d;
@@ -25,7 +24,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde::{Serialize, Serializer};
 
-pub use kernel::SampleOracles;
+pub use crate::binning::SampleOracles;
 
 use crate::camera::View;
 use crate::framebuffer::Framebuffer;

@@ -5,7 +5,7 @@
 use rayon::prelude::*;
 
 use super::PixelRect;
-use super::kernel::{SampleOracles, raster_triangle};
+use crate::binning::{SampleOracles, raster_triangle};
 use crate::edge::Coverage;
 use crate::framebuffer::{Framebuffer, TileBuffer};
 use crate::stats::RasterCounters;

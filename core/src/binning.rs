@@ -6,7 +6,7 @@
 //! tested one by one. With early-z a block is skipped when the triangle's nearest
 //! possible depth lies behind everything the hierarchical w-buffer holds there.
 
-use super::PixelRect;
+use crate::algorithm::PixelRect;
 use crate::camera::pixel_center;
 use crate::edge::Coverage;
 use crate::framebuffer::TileBuffer;
