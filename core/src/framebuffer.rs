@@ -103,6 +103,8 @@ pub struct TileBuffer {
     /// Farthest depth per cell (`+∞` while any pixel of it is empty).
     pub hiz: Vec<f32>,
     hiz_columns: u32,
+    /// Has a stored depth decreased since the last [`TileBuffer::update_hiz`]?
+    depth_lowered: bool,
 }
 
 impl TileBuffer {
@@ -121,6 +123,7 @@ impl TileBuffer {
             coverage_writes: vec![0; n],
             hiz: vec![f32::INFINITY; (hiz_columns * hiz_rows) as usize],
             hiz_columns,
+            depth_lowered: false,
         }
     }
 
@@ -137,6 +140,7 @@ impl TileBuffer {
         self.coverage_writes[i] += 1;
         let (d, t) = (self.depth[i], self.triangle_id[i]);
         if w < d || (w == d && id < t) {
+            self.depth_lowered |= w < d;
             self.depth[i] = w;
             self.triangle_id[i] = id;
         }
@@ -156,8 +160,13 @@ impl TileBuffer {
         max
     }
 
-    /// Recomputes the cells that pixels `[x0, x1] × [y0, y1]` touch.
+    /// Recomputes the cells that pixels `[x0, x1] × [y0, y1]` touch, if a depth
+    /// has decreased since the last update (every write between two updates
+    /// falls inside the rectangle the second one names).
     pub fn update_hiz(&mut self, x0: u32, y0: u32, x1: u32, y1: u32) {
+        if !std::mem::take(&mut self.depth_lowered) {
+            return;
+        }
         let (cx0, cx1) = ((x0 - self.x0) / HIZ_CELL, (x1 - self.x0) / HIZ_CELL);
         let (cy0, cy1) = ((y0 - self.y0) / HIZ_CELL, (y1 - self.y0) / HIZ_CELL);
         for cy in cy0..=cy1 {
