@@ -19,6 +19,9 @@ pub struct Framebuffer {
     /// Samples-against-triangle tests made at each pixel (each evaluates three edges).
     pub edge_evals: Vec<u32>,
     /// Samples that passed a coverage test at each pixel, before the depth test.
+    /// Algorithms with early-z or occlusion culling skip hidden blocks before
+    /// testing them, so they count fewer here (never on a closed mesh seen from
+    /// inside, where every sample has exactly one triangle).
     pub coverage_writes: Vec<u32>,
 }
 

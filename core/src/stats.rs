@@ -48,7 +48,9 @@ pub struct Stats {
     pub time_ms: StageTimes,
     /// Triangles whose edge functions were set up (2D: clipped sub-triangles).
     pub triangle_setups: u64,
-    /// Sample-against-triangle coverage tests (three edge functions each).
+    /// Sample-against-triangle evaluations of the three edge functions: per-sample
+    /// coverage tests, the four corner samples of every binning tile test, and the
+    /// samples of tiles accepted whole (their barycentrics still get evaluated).
     pub edge_evaluations: u64,
     /// BVH nodes whose children were tested against a ray.
     pub bvh_nodes_visited: u64,
