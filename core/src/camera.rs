@@ -70,12 +70,14 @@ impl Camera {
                 return Err(camera_error(field, format!("must be finite, got {v}")));
             }
         }
-        let forward = self.target - self.eye;
+        // In f64: huge but finite coordinates must not overflow the checks.
+        let forward = self.target.as_dvec3() - self.eye.as_dvec3();
+        let up = self.up.as_dvec3();
         if forward.length_squared() == 0.0 {
             return Err(camera_error("target", "must differ from eye"));
         }
-        if forward.cross(self.up).length_squared()
-            <= 1e-12 * forward.length_squared() * self.up.length_squared()
+        if forward.cross(up).length_squared()
+            <= 1e-12 * forward.length_squared() * up.length_squared()
         {
             return Err(camera_error(
                 "up",
@@ -139,9 +141,11 @@ impl View {
         if width == 0 || height == 0 {
             return Err(camera_error("size", "width and height must be positive"));
         }
-        let forward = (camera.target - camera.eye).normalize();
-        let right = forward.cross(camera.up).normalize();
-        let up = right.cross(forward);
+        // The basis in f64 (no overflow for huge coordinates), rounded once.
+        let forward64 = (camera.target.as_dvec3() - camera.eye.as_dvec3()).normalize();
+        let right64 = forward64.cross(camera.up.as_dvec3()).normalize();
+        let (forward, right) = (forward64.as_vec3(), right64.as_vec3());
+        let up = right64.cross(forward64).as_vec3();
         // tan in f64 so that e.g. 90° gives exactly 1.
         let tan_half_y64 = (f64::from(camera.fov_y_deg).to_radians() * 0.5).tan();
         let tan_half_x64 = tan_half_y64 * f64::from(width) / f64::from(height);

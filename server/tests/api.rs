@@ -231,6 +231,19 @@ fn render_json_and_png() {
         r#"{ "scene": "box", "algorithm": "3dr-brute", "size": "32x32", "camera": { "eye": [2, 1, 2], "target": [0, 0, 0], "fov_y": 50 } }"#,
     );
     assert_eq!(status, StatusCode::OK, "{doc}");
+    // Extreme but finite cameras render (nothing, or something) instead of failing.
+    for algorithm in continuum::AlgorithmId::ALL {
+        for camera in [
+            r#"{ "eye": [3e37, -3e37, 1e37], "target": [0, 0, 0], "fov_y": 179.9 }"#,
+            r#"{ "eye": [1e-30, 0, 0], "target": [2e-30, 0, 0], "fov_y": 0.001, "near": 1e-38 }"#,
+        ] {
+            let body = format!(
+                r#"{{ "scene": "sphere", "algorithm": "{algorithm}", "size": "24x16", "camera": {camera} }}"#
+            );
+            let (status, doc) = post(&s, "/api/render", &body);
+            assert_eq!(status, StatusCode::OK, "{algorithm} {camera}: {doc}");
+        }
+    }
     let (status, png) = get(
         &s,
         "/api/render.png?scene=box&algorithm=2dr-brute&size=32x24",

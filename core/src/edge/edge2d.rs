@@ -69,6 +69,9 @@ impl Triangle2D {
             t.delta[i] = [hi.x - lo.x, hi.y - lo.y];
             t.sign[i] = flip;
         }
+        if !(t.w_range[0].is_finite() && t.w_range[1].is_finite()) {
+            return None;
+        }
         // 2. Orientation from edge 0 at its opposite vertex; the triangle is kept
         //    only if every vertex is strictly inside its opposite edge.
         let orientation = t.raw(0, v[0].x, v[0].y) * t.sign[0];
@@ -126,7 +129,8 @@ impl Coverage for Triangle2D {
         let sum = e[0] + e[1] + e[2];
         let inv_w = e[0] * self.inv_w[0] + e[1] * self.inv_w[1] + e[2] * self.inv_w[2];
         let w = sum / inv_w;
-        (w > 0.0 && w < f32::INFINITY).then(|| w.clamp(self.w_range[0], self.w_range[1]))
+        // max/min rather than clamp: never panics, equal for ordered bounds.
+        (w > 0.0 && w < f32::INFINITY).then(|| w.max(self.w_range[0]).min(self.w_range[1]))
     }
 
     fn edge_error(&self) -> [f32; 3] {

@@ -117,6 +117,7 @@ impl Triangle3D {
             .flatten()
             .chain(&nd)
             .chain(&[volume])
+            .chain(&t.w_range)
             .all(|v| v.is_finite());
         finite.then_some(t)
     }
@@ -145,7 +146,10 @@ impl Coverage for Triangle3D {
         if facing <= 0.0 {
             return None;
         }
-        let w = (self.volume / facing).clamp(self.w_range[0], self.w_range[1]);
+        // max/min rather than clamp: never panics, and the 8-lane path rounds alike.
+        let w = (self.volume / facing)
+            .max(self.w_range[0])
+            .min(self.w_range[1]);
         (w >= self.near).then_some(w)
     }
 
