@@ -47,14 +47,7 @@ pub(crate) fn raster_triangle<T: Coverage>(
     counters: &mut RasterCounters,
 ) {
     if !oracles.binning {
-        if oracles.early_z && early_z_rejects(tile, tri, clip, counters) {
-            return;
-        }
-        test_samples(tile, tri, id, clip);
-        if oracles.early_z {
-            tile.update_hiz(clip.x0, clip.y0, clip.x1, clip.y1);
-        }
-        return;
+        return sample_block(tile, tri, id, clip, oracles, counters);
     }
     // Start from the smallest block of the tile's power-of-two hierarchy that
     // holds the triangle's box ("binning starting from the bounding box").
@@ -77,6 +70,25 @@ pub(crate) fn raster_triangle<T: Coverage>(
         oracles,
         counters,
     );
+}
+
+/// The samples of `r` one by one (the leaf of every strategy), after early-z and
+/// keeping the hierarchical w-buffer current when early-z reads it.
+fn sample_block<T: Coverage>(
+    tile: &mut TileBuffer,
+    tri: &T,
+    id: u32,
+    r: PixelRect,
+    oracles: SampleOracles,
+    counters: &mut RasterCounters,
+) {
+    if oracles.early_z && early_z_rejects(tile, tri, r, counters) {
+        return;
+    }
+    test_samples(tile, tri, id, r);
+    if oracles.early_z {
+        tile.update_hiz(r.x0, r.y0, r.x1, r.y1);
+    }
 }
 
 /// Early-z: is the triangle's nearest depth behind everything stored under `r`?
@@ -198,25 +210,21 @@ fn bin_block<T: Coverage>(
     counters: &mut RasterCounters,
 ) {
     // 1. The block's samples inside the triangle's box.
-    let r = PixelRect {
-        x0: bx.max(clip.x0),
-        y0: by.max(clip.y0),
-        x1: (bx + side - 1).min(clip.x1),
-        y1: (by + side - 1).min(clip.y1),
+    let block = PixelRect {
+        x0: bx,
+        y0: by,
+        x1: bx + side - 1,
+        y1: by + side - 1,
     };
-    if r.x0 > r.x1 || r.y0 > r.y1 {
+    let Some(r) = block.intersect(clip) else {
         return;
-    }
-    // 2. Early-z against the hierarchical w-buffer.
-    if oracles.early_z && early_z_rejects(tile, tri, r, counters) {
-        return;
-    }
-    // 3. Leaf: sample by sample.
+    };
+    // 2. Leaf: sample by sample.
     if side <= oracles.leaf {
-        test_samples(tile, tri, id, r);
-        if oracles.early_z {
-            tile.update_hiz(r.x0, r.y0, r.x1, r.y1);
-        }
+        return sample_block(tile, tri, id, r, oracles, counters);
+    }
+    // 3. Early-z against the hierarchical w-buffer.
+    if oracles.early_z && early_z_rejects(tile, tri, r, counters) {
         return;
     }
     // 4. The tile test.

@@ -5,6 +5,14 @@
 /// Triangle id of a pixel no triangle covers.
 pub const BACKGROUND: u32 = u32::MAX;
 
+/// The w-buffer test every algorithm uses: a sample at depth `w` of triangle `id`
+/// replaces the stored `(depth, stored_id)` when it is nearer, or equally near
+/// with a smaller id — so no result depends on drawing or traversal order.
+#[inline(always)]
+pub fn wins_depth_test(w: f32, id: u32, depth: f32, stored_id: u32) -> bool {
+    w < depth || (w == depth && id < stored_id)
+}
+
 /// All per-pixel buffers of one render, row-major, `y` down.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Framebuffer {
@@ -130,6 +138,16 @@ impl TileBuffer {
         }
     }
 
+    /// The tile's pixels as an inclusive rectangle.
+    pub(crate) fn rect(&self) -> crate::algorithm::PixelRect {
+        crate::algorithm::PixelRect {
+            x0: self.x0,
+            y0: self.y0,
+            x1: self.x1 - 1,
+            y1: self.y1 - 1,
+        }
+    }
+
     /// Index of pixel `(x, y)` (screen coordinates) in the tile's buffers.
     #[inline(always)]
     pub fn index(&self, x: u32, y: u32) -> usize {
@@ -142,7 +160,7 @@ impl TileBuffer {
     pub fn write(&mut self, i: usize, w: f32, id: u32) {
         self.coverage_writes[i] += 1;
         let (d, t) = (self.depth[i], self.triangle_id[i]);
-        if w < d || (w == d && id < t) {
+        if wins_depth_test(w, id, d, t) {
             self.depth_lowered |= w < d;
             self.depth[i] = w;
             self.triangle_id[i] = id;

@@ -24,7 +24,7 @@ pub fn heat_color(t: f64) -> [u8; 4] {
 }
 
 pub fn color_image(fb: &Framebuffer) -> RgbaImage {
-    from_pixels(fb, fb.color.clone())
+    from_pixels(fb, fb.color.iter().copied())
 }
 
 pub fn edge_eval_image(fb: &Framebuffer) -> RgbaImage {
@@ -33,8 +33,7 @@ pub fn edge_eval_image(fb: &Framebuffer) -> RgbaImage {
         fb,
         fb.edge_evals
             .iter()
-            .map(|&n| heat_color(heat_position(n, max)))
-            .collect(),
+            .map(|&n| heat_color(heat_position(n, max))),
     )
 }
 
@@ -47,17 +46,14 @@ pub fn depth_image(fb: &Framebuffer) -> RgbaImage {
     let span = (hi - lo).max(f32::MIN_POSITIVE);
     from_pixels(
         fb,
-        fb.depth
-            .iter()
-            .map(|&d| {
-                if d.is_finite() {
-                    let g = (255.0 - 200.0 * (d - lo) / span) as u8;
-                    [g, g, g, 255]
-                } else {
-                    [0, 0, 0, 255]
-                }
-            })
-            .collect(),
+        fb.depth.iter().map(|&d| {
+            if d.is_finite() {
+                let g = (255.0 - 200.0 * (d - lo) / span) as u8;
+                [g, g, g, 255]
+            } else {
+                [0, 0, 0, 255]
+            }
+        }),
     )
 }
 
@@ -65,23 +61,20 @@ pub fn depth_image(fb: &Framebuffer) -> RgbaImage {
 pub fn triangle_id_image(fb: &Framebuffer) -> RgbaImage {
     from_pixels(
         fb,
-        fb.triangle_id
-            .iter()
-            .map(|&id| {
-                if id == BACKGROUND {
-                    [0, 0, 0, 255]
-                } else {
-                    let h = id.wrapping_mul(0x9E37_79B1).rotate_left(13) ^ 0x5bd1_e995;
-                    let [r, g, b, _] = h.to_le_bytes();
-                    [r | 0x30, g | 0x30, b | 0x30, 255]
-                }
-            })
-            .collect(),
+        fb.triangle_id.iter().map(|&id| {
+            if id == BACKGROUND {
+                [0, 0, 0, 255]
+            } else {
+                let h = id.wrapping_mul(0x9E37_79B1).rotate_left(13) ^ 0x5bd1_e995;
+                let [r, g, b, _] = h.to_le_bytes();
+                [r | 0x30, g | 0x30, b | 0x30, 255]
+            }
+        }),
     )
 }
 
-fn from_pixels(fb: &Framebuffer, pixels: Vec<[u8; 4]>) -> RgbaImage {
-    let raw: Vec<u8> = pixels.into_iter().flatten().collect();
+fn from_pixels(fb: &Framebuffer, pixels: impl Iterator<Item = [u8; 4]>) -> RgbaImage {
+    let raw: Vec<u8> = pixels.flatten().collect();
     RgbaImage::from_raw(fb.width, fb.height, raw).expect("buffer has width × height pixels")
 }
 

@@ -90,13 +90,7 @@ impl<'a> Traversal<'a> {
             return;
         }
         let root = self.node_box(bvh.total_aabb.min, bvh.total_aabb.max);
-        let t = &self.tile;
-        let f = PixelRect {
-            x0: t.x0,
-            y0: t.y0,
-            x1: t.x1 - 1,
-            y1: t.y1 - 1,
-        };
+        let f = self.tile.rect();
         self.counters.frusta_created += 1;
         self.traverse(f, NodeRef::Inner(0), root);
     }
@@ -257,15 +251,9 @@ impl<'a> Traversal<'a> {
             let Some(rect) = screen_rect(p, self.view) else {
                 continue;
             };
-            let clip = PixelRect {
-                x0: rect.x0.max(f.x0),
-                y0: rect.y0.max(f.y0),
-                x1: rect.x1.min(f.x1),
-                y1: rect.y1.min(f.y1),
-            };
-            if clip.x0 > clip.x1 || clip.y0 > clip.y1 {
+            let Some(clip) = rect.intersect(f) else {
                 continue;
-            }
+            };
             self.setups += 1;
             let Some(tri) = Triangle3D::setup(p, self.view) else {
                 continue;

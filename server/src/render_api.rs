@@ -255,11 +255,9 @@ pub async fn scenes(State(state): State<Arc<AppState>>) -> Result<Json<Value>, A
             .into_iter()
             .map(|name| match state.prepared(&name) {
                 Ok(p) => {
-                    let mut cameras = p.scene.cameras.clone();
-                    if !cameras.iter().any(|c| c.name == "default") {
-                        cameras.push(p.scene.default_camera());
-                    }
-                    let cameras: Vec<Value> = cameras
+                    let cameras: Vec<Value> = p
+                        .scene
+                        .all_cameras()
                         .iter()
                         .map(|c| {
                             json!({

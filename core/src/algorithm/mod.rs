@@ -382,6 +382,18 @@ pub(crate) struct PixelRect {
 }
 
 impl PixelRect {
+    /// The pixels in both rectangles, or `None`.
+    #[inline]
+    pub fn intersect(self, o: PixelRect) -> Option<PixelRect> {
+        let r = PixelRect {
+            x0: self.x0.max(o.x0),
+            y0: self.y0.max(o.y0),
+            x1: self.x1.min(o.x1),
+            y1: self.y1.min(o.y1),
+        };
+        (r.x0 <= r.x1 && r.y0 <= r.y1).then_some(r)
+    }
+
     /// The pixels whose centres lie in `[min_x, max_x] × [min_y, max_y]`, clamped
     /// to a `width × height` image; `None` when there are none.
     pub fn from_bounds(

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use crate::camera::{View, pixel_center};
 use crate::edge::{Coverage, Triangle3D};
-use crate::framebuffer::{BACKGROUND, Framebuffer};
+use crate::framebuffer::{BACKGROUND, Framebuffer, wins_depth_test};
 use crate::prepared::PreparedScene;
 use crate::stats::Stats;
 
@@ -57,7 +57,7 @@ pub(crate) fn render_raycast(
                             if let Some(w) = tri.sample(xc, yc) {
                                 covered += 1;
                                 let id = scene.slot_triangles[k as usize];
-                                if w < best_w || (w == best_w && id < best_id) {
+                                if wins_depth_test(w, id, best_w, best_id) {
                                     best_w = w;
                                     best_id = id;
                                 }

@@ -66,13 +66,10 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
             let mut counters = RasterCounters::default();
             for &k in &members[offsets[t] as usize..offsets[t + 1] as usize] {
                 let item = &items[k as usize];
-                let clip = PixelRect {
-                    x0: item.rect.x0.max(x0),
-                    y0: item.rect.y0.max(y0),
-                    x1: item.rect.x1.min(x1 - 1),
-                    y1: item.rect.y1.min(y1 - 1),
-                };
-                raster_triangle(&mut tile, &item.tri, item.id, clip, oracles, &mut counters);
+                // Non-empty: the item was sorted into this tile by its rect.
+                if let Some(clip) = item.rect.intersect(tile.rect()) {
+                    raster_triangle(&mut tile, &item.tri, item.id, clip, oracles, &mut counters);
+                }
             }
             (tile, counters)
         })

@@ -275,13 +275,19 @@ impl Scene {
             })
     }
 
-    /// Names of the scene's cameras (plus `default`, which always exists).
-    pub fn camera_names(&self) -> Vec<String> {
-        let mut names: Vec<String> = self.cameras.iter().map(|c| c.name.clone()).collect();
-        if !names.iter().any(|n| n == "default") {
-            names.push("default".into());
+    /// The scene's cameras plus `default` (which always exists: it frames the
+    /// bounds unless the scene names a camera so).
+    pub fn all_cameras(&self) -> Vec<Camera> {
+        let mut cameras = self.cameras.clone();
+        if !cameras.iter().any(|c| c.name == "default") {
+            cameras.push(self.default_camera());
         }
-        names
+        cameras
+    }
+
+    /// Names of [`Scene::all_cameras`].
+    pub fn camera_names(&self) -> Vec<String> {
+        self.all_cameras().into_iter().map(|c| c.name).collect()
     }
 
     /// The scene's first camera, or one that frames its bounds.
