@@ -8,7 +8,7 @@
 
 use crate::algorithm::PixelRect;
 use crate::camera::pixel_center;
-use crate::edge::Coverage;
+use crate::edge::{BlockTest, Coverage};
 use crate::framebuffer::TileBuffer;
 use crate::stats::RasterCounters;
 
@@ -21,6 +21,9 @@ pub struct SampleOracles {
     pub leaf: u32,
     /// Skip blocks that the hierarchical w-buffer shows are hidden.
     pub early_z: bool,
+    /// Parabolic viewport: evaluate edges along rows with the double-incremental
+    /// scheme of §3.5 eq. 3 (same decisions as direct evaluation).
+    pub incremental: bool,
 }
 
 impl SampleOracles {
@@ -28,11 +31,13 @@ impl SampleOracles {
         binning: false,
         leaf: 8,
         early_z: false,
+        incremental: false,
     };
     pub const BINNED: SampleOracles = SampleOracles {
         binning: true,
         leaf: 8,
         early_z: true,
+        incremental: false,
     };
 }
 
@@ -47,7 +52,8 @@ pub(crate) fn raster_triangle<T: Coverage>(
     counters: &mut RasterCounters,
 ) {
     if !oracles.binning {
-        return sample_block(tile, tri, id, clip, oracles, counters);
+        sample_block(tile, tri, id, clip, oracles, counters);
+        return;
     }
     // Start from the smallest block of the tile's power-of-two hierarchy that
     // holds the triangle's box ("binning starting from the bounding box").
@@ -58,22 +64,13 @@ pub(crate) fn raster_triangle<T: Coverage>(
         side *= 2;
     }
     let (bx, by) = (tile.x0 + lx0 / side * side, tile.y0 + ly0 / side * side);
-    bin_block(
-        tile,
-        tri,
-        id,
-        clip,
-        bx,
-        by,
-        side,
-        tri.edge_error(),
-        oracles,
-        counters,
-    );
+    bin_block(tile, tri, id, clip, bx, by, side, oracles, counters);
 }
 
 /// The samples of `r` one by one (the leaf of every strategy), after early-z and
-/// keeping the hierarchical w-buffer current when early-z reads it.
+/// keeping the hierarchical w-buffer current when early-z reads it. Returns the
+/// number of samples the triangle covers (before the depth test); early-z
+/// rejects count none.
 fn sample_block<T: Coverage>(
     tile: &mut TileBuffer,
     tri: &T,
@@ -81,14 +78,15 @@ fn sample_block<T: Coverage>(
     r: PixelRect,
     oracles: SampleOracles,
     counters: &mut RasterCounters,
-) {
+) -> u32 {
     if oracles.early_z && early_z_rejects(tile, tri, r, counters) {
-        return;
+        return 0;
     }
-    test_samples(tile, tri, id, r);
+    let covered = test_samples(tile, tri, id, r);
     if oracles.early_z {
         tile.update_hiz(r.x0, r.y0, r.x1, r.y1);
     }
+    covered
 }
 
 /// Early-z: is the triangle's nearest depth behind everything stored under `r`?
@@ -107,90 +105,58 @@ fn early_z_rejects<T: Coverage>(
     false
 }
 
-/// Tests every sample of `r` (per-sample coverage, the leaf of every strategy).
+/// Tests every sample of `r` (per-sample coverage, the leaf of every strategy);
+/// returns how many are covered.
 #[inline]
-fn test_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRect) {
+fn test_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRect) -> u32 {
+    let mut covered = 0;
     for y in r.y0..=r.y1 {
-        let yc = pixel_center(y);
-        let mut x = r.x0;
-        // Eight samples at a time, then the rest one by one.
-        while x + 7 <= r.x1 {
-            let (mask, depth) = tri.sample8(pixel_center(x), yc);
-            let i = tile.index(x, y);
-            for count in &mut tile.edge_evals[i..i + 8] {
-                *count += 1;
-            }
-            let mut covered = mask;
-            while covered != 0 {
-                let k = covered.trailing_zeros() as usize;
-                covered &= covered - 1;
-                tile.write(i + k, depth[k], id);
-            }
-            x += 8;
+        let i = tile.index(r.x0, y);
+        let n = r.x1 - r.x0 + 1;
+        for count in &mut tile.edge_evals[i..i + n as usize] {
+            *count += 1;
         }
-        for x in x..=r.x1 {
-            let i = tile.index(x, y);
-            tile.edge_evals[i] += 1;
-            if let Some(w) = tri.sample(pixel_center(x), yc) {
-                tile.write(i, w, id);
-            }
-        }
+        tri.sample_run(pixel_center(r.x0), pixel_center(y), n, |k, w| {
+            covered += 1;
+            tile.write(i + k as usize, w, id);
+        });
     }
+    covered
 }
 
-/// Writes every sample of `r`, known to be covered: only depth is computed.
+/// Writes every sample of `r`, known to be inside the edges: only depth is
+/// computed. Returns the number of samples written.
 #[inline]
-fn fill_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRect) {
+fn fill_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRect) -> u32 {
+    let mut written = 0;
     for y in r.y0..=r.y1 {
         let yc = pixel_center(y);
         for x in r.x0..=r.x1 {
             let i = tile.index(x, y);
             tile.edge_evals[i] += 1;
-            let xc = pixel_center(x);
-            if let Some(w) = tri.depth(tri.edge_values(xc, yc), xc, yc) {
+            if let Some(w) = tri.depth_inside(pixel_center(x), yc) {
+                written += 1;
                 tile.write(i, w, id);
             }
         }
     }
+    written
 }
 
-/// Where a block stands against one triangle.
-enum BlockTest {
-    Outside,
-    Inside,
-    Partial,
-}
-
-/// Edge functions at the four corner samples of `r`: outside if some edge is
-/// negative beyond its error bound at all four, inside if every edge is positive
-/// beyond it at all four (paper §3.1: "binning"). The four corner pixels are
-/// charged one evaluation each.
+/// The triangle's block test at the four corner samples of `r` (paper §3.1:
+/// "binning"; curved edges §3.5), each corner pixel charged one evaluation.
 #[inline]
-fn test_block<T: Coverage>(
-    tile: &mut TileBuffer,
-    tri: &T,
-    r: PixelRect,
-    errors: [f32; 3],
-) -> BlockTest {
-    let corners = [(r.x0, r.y0), (r.x1, r.y0), (r.x0, r.y1), (r.x1, r.y1)];
-    let mut lo = [f32::INFINITY; 3];
-    let mut hi = [f32::NEG_INFINITY; 3];
-    for (x, y) in corners {
+fn test_block<T: Coverage>(tile: &mut TileBuffer, tri: &T, r: PixelRect) -> BlockTest {
+    for (x, y) in [(r.x0, r.y0), (r.x1, r.y0), (r.x0, r.y1), (r.x1, r.y1)] {
         let i = tile.index(x, y);
         tile.edge_evals[i] += 1;
-        let e = tri.edge_values(pixel_center(x), pixel_center(y));
-        for k in 0..3 {
-            lo[k] = lo[k].min(e[k]);
-            hi[k] = hi[k].max(e[k]);
-        }
     }
-    if (0..3).any(|k| hi[k] < -errors[k]) {
-        BlockTest::Outside
-    } else if (0..3).all(|k| lo[k] > errors[k]) {
-        BlockTest::Inside
-    } else {
-        BlockTest::Partial
-    }
+    tri.classify_block(
+        pixel_center(r.x0),
+        pixel_center(r.y0),
+        pixel_center(r.x1),
+        pixel_center(r.y1),
+    )
 }
 
 #[allow(
@@ -205,10 +171,9 @@ fn bin_block<T: Coverage>(
     bx: u32,
     by: u32,
     side: u32,
-    errors: [f32; 3],
     oracles: SampleOracles,
     counters: &mut RasterCounters,
-) {
+) -> u32 {
     // 1. The block's samples inside the triangle's box.
     let block = PixelRect {
         x0: bx,
@@ -217,7 +182,7 @@ fn bin_block<T: Coverage>(
         y1: by + side - 1,
     };
     let Some(r) = block.intersect(clip) else {
-        return;
+        return 0;
     };
     // 2. Leaf: sample by sample.
     if side <= oracles.leaf {
@@ -225,35 +190,37 @@ fn bin_block<T: Coverage>(
     }
     // 3. Early-z against the hierarchical w-buffer.
     if oracles.early_z && early_z_rejects(tile, tri, r, counters) {
-        return;
+        return 0;
     }
     // 4. The tile test.
     counters.tiles_tested += 1;
-    match test_block(tile, tri, r, errors) {
-        BlockTest::Outside => counters.tiles_rejected += 1,
+    match test_block(tile, tri, r) {
+        BlockTest::Outside => {
+            counters.tiles_rejected += 1;
+            0
+        }
         BlockTest::Inside => {
             counters.tiles_accepted += 1;
-            fill_samples(tile, tri, id, r);
+            let written = fill_samples(tile, tri, id, r);
             if oracles.early_z {
                 tile.update_hiz(r.x0, r.y0, r.x1, r.y1);
             }
+            written
         }
         BlockTest::Partial => {
+            counters.tiles_refined += 1;
             let half = side / 2;
-            for (dx, dy) in [(0, 0), (half, 0), (0, half), (half, half)] {
-                bin_block(
-                    tile,
-                    tri,
-                    id,
-                    clip,
-                    bx + dx,
-                    by + dy,
-                    half,
-                    errors,
-                    oracles,
-                    counters,
-                );
+            let covered: u32 = [(0, 0), (half, 0), (0, half), (half, half)]
+                .into_iter()
+                .map(|(dx, dy)| {
+                    let (x, y) = (bx + dx, by + dy);
+                    bin_block(tile, tri, id, clip, x, y, half, oracles, counters)
+                })
+                .sum();
+            if covered == 0 {
+                counters.tiles_refined_empty += 1;
             }
+            covered
         }
     }
 }

@@ -1,27 +1,29 @@
-//! The pinhole camera and its sample generator (paper §3.2).
+//! Cameras and their sample generators (paper §3.2, §3.3, §3.5).
 //!
-//! A [`View`] is a camera at one image size. It turns pixel coordinates into ray
-//! directions `d(x, y) = d0 + x·dx + y·dy`, pixel centres at `(px + 0.5, py + 0.5)`,
-//! `y` growing downwards. `d0 · forward = 1` and `dx, dy ⟂ forward`, so the ray
-//! parameter `t` of a point `e + t·d` *is* its view-axis distance `w`: every
-//! algorithm's depth buffer holds `w`.
+//! A [`View`] is a camera at one image size. For the planar viewports it turns
+//! pixel coordinates into rays `o(x, y) + t·d(x, y)` with `o` and `d` linear in
+//! `(x, y)`: perspective `d(x, y) = d0 + x·dx + y·dy` from the eye, orthographic
+//! `o(x, y) = o0 + x·ox + y·oy` along the view axis. Pixel centres are at
+//! `(px + 0.5, py + 0.5)`, `y` growing downwards. `d · forward = 1`, so the ray
+//! parameter `t` *is* the view-axis distance `w` that the depth buffer holds.
+//! The non-planar viewports ([`SphereMap`]) give unit-length-scaled rays from the
+//! eye and store the Euclidean distance.
 
 use glam::{DVec3, Vec3};
-use serde::{Deserialize, Serialize};
 
 use crate::scene::Bounds;
+pub use crate::viewport::{SphereMap, Viewport};
 
-/// A named pinhole camera: where it is, what it looks at, and its vertical field of
-/// view. `near` is the distance below which nothing is drawn (the 2D family clips
+/// A named camera: where it is, what it looks at, and how pixels map to rays.
+/// `near` is the distance below which nothing is drawn (the 2D family clips
 /// there, the 3D family and the ray caster reject samples with `w < near`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
     pub name: String,
     pub eye: Vec3,
     pub target: Vec3,
     pub up: Vec3,
-    /// Vertical field of view in degrees, in (0, 180).
-    pub fov_y_deg: f32,
+    pub viewport: Viewport,
     /// Near distance; `None` takes the prepared scene's default.
     pub near: Option<f32>,
 }
@@ -58,7 +60,7 @@ impl Camera {
             eye: center + direction * distance,
             target: center,
             up: Vec3::Y,
-            fov_y_deg,
+            viewport: Viewport::Perspective { fov_y_deg },
             near: None,
         }
     }
@@ -84,12 +86,9 @@ impl Camera {
                 "must not be zero or parallel to the view direction",
             ));
         }
-        if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
-            return Err(camera_error(
-                "fov_y",
-                format!("must be in (0, 180) degrees, got {}", self.fov_y_deg),
-            ));
-        }
+        self.viewport
+            .validate()
+            .map_err(|m| camera_error("viewport", m))?;
         if let Some(near) = self.near
             && !(near > 0.0 && near.is_finite())
         {
@@ -112,20 +111,32 @@ pub struct View {
     pub right: Vec3,
     /// Unit image-up axis (image rows grow along `-up`).
     pub up: Vec3,
-    /// Direction through the image corner `(0, 0)`; `d0 · forward = 1`.
+    pub viewport: Viewport,
+    /// Planar: ray direction at image point `(0, 0)`, `d0 · forward = 1`
+    /// (orthographic: `forward`).
     pub d0: Vec3,
-    /// `∂d/∂x`: one pixel to the right.
+    /// Planar: `∂d/∂x`, one pixel to the right (orthographic: zero).
     pub dx: Vec3,
-    /// `∂d/∂y`: one pixel down.
+    /// Planar: `∂d/∂y`, one pixel down (orthographic: zero).
     pub dy: Vec3,
+    /// Planar: ray origin at image point `(0, 0)` (perspective: the eye).
+    pub o0: Vec3,
+    /// Planar: `∂o/∂x` (perspective: zero).
+    pub ox: Vec3,
+    /// Planar: `∂o/∂y` (perspective: zero).
+    pub oy: Vec3,
     pub width: u32,
     pub height: u32,
-    /// Nothing nearer than this along the view axis is drawn.
+    /// Nothing nearer than this is drawn (along the view axis; for non-planar
+    /// viewports, from the eye).
     pub near: f32,
-    /// `tan(fov_y / 2)`.
-    pub tan_half_y: f32,
-    /// `tan(fov_y / 2) · width / height`.
-    pub tan_half_x: f32,
+    /// Half the image height: perspective `tan(fov_y / 2)` per unit of `w`,
+    /// orthographic in scene units.
+    pub half_y: f32,
+    /// Half the image width, `half_y · width / height`.
+    pub half_x: f32,
+    /// The sample generator of a non-planar viewport.
+    pub sphere: Option<SphereMap>,
 }
 
 impl View {
@@ -146,34 +157,95 @@ impl View {
         let right64 = forward64.cross(camera.up.as_dvec3()).normalize();
         let (forward, right) = (forward64.as_vec3(), right64.as_vec3());
         let up = right64.cross(forward64).as_vec3();
-        // tan in f64 so that e.g. 90° gives exactly 1.
-        let tan_half_y64 = (f64::from(camera.fov_y_deg).to_radians() * 0.5).tan();
-        let tan_half_x64 = tan_half_y64 * f64::from(width) / f64::from(height);
-        let (tan_half_y, tan_half_x) = (tan_half_y64 as f32, tan_half_x64 as f32);
-        let dx = right * (2.0 * tan_half_x / width as f32);
-        let dy = up * (-2.0 * tan_half_y / height as f32);
-        let d0 = forward - right * tan_half_x + up * tan_half_y;
+        // Half extents in f64 so that e.g. 90° gives exactly 1.
+        let half_y64 = match camera.viewport {
+            Viewport::Perspective { fov_y_deg } => (f64::from(fov_y_deg).to_radians() * 0.5).tan(),
+            Viewport::Orthographic { height } => f64::from(height) * 0.5,
+            Viewport::Parabolic | Viewport::LatLong => 1.0,
+        };
+        let half_x64 = half_y64 * f64::from(width) / f64::from(height);
+        let (half_y, half_x) = (half_y64 as f32, half_x64 as f32);
+        let step_x = right * (2.0 * half_x / width as f32);
+        let step_y = up * (-2.0 * half_y / height as f32);
+        // The image corner (0, 0) relative to the eye (orthographic) or along the
+        // view axis at w = 1 (perspective).
+        let corner = |base: Vec3| base - right * half_x + up * half_y;
+        let (d0, dx, dy, o0, ox, oy) = match camera.viewport {
+            Viewport::Orthographic { .. } => (
+                forward,
+                Vec3::ZERO,
+                Vec3::ZERO,
+                corner(camera.eye),
+                step_x,
+                step_y,
+            ),
+            _ => (
+                corner(forward),
+                step_x,
+                step_y,
+                camera.eye,
+                Vec3::ZERO,
+                Vec3::ZERO,
+            ),
+        };
         Ok(View {
             eye: camera.eye,
             forward,
             right,
             up,
+            viewport: camera.viewport,
             d0,
             dx,
             dy,
+            o0,
+            ox,
+            oy,
             width,
             height,
             near: camera.near.unwrap_or(default_near),
-            tan_half_y,
-            tan_half_x,
+            half_y,
+            half_x,
+            sphere: SphereMap::new(camera.viewport, width, height),
         })
     }
 
-    /// The ray direction through image point `(x, y)` (pixel units), evaluated as
-    /// `(d0 + x·dx) + y·dy` with no fused multiply-add.
+    /// Is this an orthographic view?
+    #[inline]
+    pub fn is_orthographic(&self) -> bool {
+        matches!(self.viewport, Viewport::Orthographic { .. })
+    }
+
+    /// Planar views: the ray direction through image point `(x, y)` (pixel
+    /// units), evaluated as `(d0 + x·dx) + y·dy` with no fused multiply-add.
     #[inline]
     pub fn direction(&self, x: f32, y: f32) -> Vec3 {
         self.d0 + self.dx * x + self.dy * y
+    }
+
+    /// Planar views: the ray origin for image point `(x, y)`.
+    #[inline]
+    pub fn origin(&self, x: f32, y: f32) -> Vec3 {
+        self.o0 + self.ox * x + self.oy * y
+    }
+
+    /// The ray through image point `(x, y)`: origin and direction, scaled so that
+    /// `origin + direction · depth` is the point a depth-buffer value names.
+    /// `None` where the viewport has no ray (outside the parabolic disc).
+    #[inline]
+    pub fn ray(&self, x: f32, y: f32) -> Option<(Vec3, Vec3)> {
+        match &self.sphere {
+            None => Some((self.origin(x, y), self.direction(x, y))),
+            Some(map) => {
+                let d = map.direction(f64::from(x), f64::from(y))?;
+                Some((self.eye, self.camera_to_world(d).normalize().as_vec3()))
+            }
+        }
+    }
+
+    /// A camera-space vector `(right, up, forward)` in world space.
+    #[inline]
+    pub fn camera_to_world(&self, c: DVec3) -> DVec3 {
+        self.right.as_dvec3() * c.x + self.up.as_dvec3() * c.y + self.forward.as_dvec3() * c.z
     }
 
     /// The same direction in f64 (for checks that need more precision than the
@@ -189,14 +261,30 @@ impl View {
         Vec3::new(v.dot(self.right), v.dot(self.up), v.dot(self.forward))
     }
 
-    /// Camera-space point with `w > 0` → pixel coordinates; the exact inverse of
-    /// [`View::direction`] in real arithmetic.
+    /// World point → camera space in f64 (the non-planar viewports' setup).
+    #[inline]
+    pub fn to_camera_f64(&self, p: Vec3) -> DVec3 {
+        let v = p.as_dvec3() - self.eye.as_dvec3();
+        DVec3::new(
+            v.dot(self.right.as_dvec3()),
+            v.dot(self.up.as_dvec3()),
+            v.dot(self.forward.as_dvec3()),
+        )
+    }
+
+    /// Planar views: camera-space point (perspective: with `w > 0`) → pixel
+    /// coordinates; the exact inverse of the ray generator in real arithmetic.
     #[inline]
     pub fn project(&self, c: Vec3) -> (f32, f32) {
         let half_w = self.width as f32 * 0.5;
         let half_h = self.height as f32 * 0.5;
-        let x = (c.x / c.z / self.tan_half_x + 1.0) * half_w;
-        let y = (1.0 - c.y / c.z / self.tan_half_y) * half_h;
+        let (px, py) = if self.is_orthographic() {
+            (c.x, c.y)
+        } else {
+            (c.x / c.z, c.y / c.z)
+        };
+        let x = (px / self.half_x + 1.0) * half_w;
+        let y = (1.0 - py / self.half_y) * half_h;
         (x, y)
     }
 

@@ -9,6 +9,8 @@
 
 use glam::Vec3;
 
+use crate::camera::View;
+
 /// Guard band half-extent in units of the screen half-extent (2 = screen plus
 /// half a screen on every side).
 pub const GUARD_BAND: f32 = 2.0;
@@ -45,31 +47,34 @@ impl ClipPlane {
 }
 
 /// The five planes of the 2D pipeline: near, then the guard band's left, right,
-/// bottom and top (for `x/w ∈ [−G·tan_x, G·tan_x]`, likewise `y`).
-pub fn pipeline_planes(near: f32, tan_half_x: f32, tan_half_y: f32) -> [ClipPlane; 5] {
-    let gx = GUARD_BAND * tan_half_x;
-    let gy = GUARD_BAND * tan_half_y;
+/// bottom and top: perspective `x/w ∈ [−G·half_x, G·half_x]`, orthographic
+/// `x ∈ [−G·half_x, G·half_x]`, likewise `y`.
+pub fn pipeline_planes(view: &View) -> [ClipPlane; 5] {
+    planes_for(view.near, view.half_x, view.half_y, view.is_orthographic())
+}
+
+fn planes_for(near: f32, half_x: f32, half_y: f32, orthographic: bool) -> [ClipPlane; 5] {
+    let gx = GUARD_BAND * half_x;
+    let gy = GUARD_BAND * half_y;
+    let side = |k: Vec3, g: f32| {
+        if orthographic {
+            ClipPlane { k, offset: -g }
+        } else {
+            ClipPlane {
+                k: Vec3::new(k.x, k.y, g),
+                offset: 0.0,
+            }
+        }
+    };
     [
         ClipPlane {
             k: Vec3::Z,
             offset: near,
         },
-        ClipPlane {
-            k: Vec3::new(1.0, 0.0, gx),
-            offset: 0.0,
-        },
-        ClipPlane {
-            k: Vec3::new(-1.0, 0.0, gx),
-            offset: 0.0,
-        },
-        ClipPlane {
-            k: Vec3::new(0.0, 1.0, gy),
-            offset: 0.0,
-        },
-        ClipPlane {
-            k: Vec3::new(0.0, -1.0, gy),
-            offset: 0.0,
-        },
+        side(Vec3::X, gx),
+        side(-Vec3::X, gx),
+        side(Vec3::Y, gy),
+        side(-Vec3::Y, gy),
     ]
 }
 
@@ -136,7 +141,7 @@ mod tests {
 
     #[test]
     fn untouched_triangle_is_returned_as_is() {
-        let planes = pipeline_planes(0.1, 1.0, 1.0);
+        let planes = planes_for(0.1, 1.0, 1.0, false);
         let tri = [
             Vec3::new(0.0, 0.0, 1.0),
             Vec3::new(0.1, 0.0, 1.0),
@@ -148,7 +153,7 @@ mod tests {
 
     #[test]
     fn near_plane_cuts_a_triangle_through_the_eye_plane() {
-        let planes = pipeline_planes(0.5, 1.0, 1.0);
+        let planes = planes_for(0.5, 1.0, 1.0, false);
         let tri = [
             Vec3::new(0.0, 0.0, -1.0),
             Vec3::new(0.2, 0.0, 2.0),
@@ -161,7 +166,7 @@ mod tests {
 
     #[test]
     fn shared_edge_clips_to_identical_vertices_in_both_orders() {
-        let planes = pipeline_planes(0.5, 1.0, 1.0);
+        let planes = planes_for(0.5, 1.0, 1.0, false);
         let (a, b) = (Vec3::new(0.1, 0.3, -0.7), Vec3::new(0.3, -0.2, 3.1));
         let t1 = clip_triangle([a, b, Vec3::new(0.5, 0.5, 2.0)], &planes).expect("visible");
         let t2 = clip_triangle([b, a, Vec3::new(-0.5, 0.5, 2.0)], &planes).expect("visible");
@@ -182,7 +187,7 @@ mod tests {
 
     #[test]
     fn triangle_behind_the_eye_vanishes() {
-        let planes = pipeline_planes(0.1, 1.0, 1.0);
+        let planes = planes_for(0.1, 1.0, 1.0, false);
         let tri = [
             Vec3::new(0.0, 0.0, -1.0),
             Vec3::new(1.0, 0.0, -1.0),

@@ -30,6 +30,7 @@ pub mod scene;
 pub mod shade;
 pub mod stats;
 pub mod traversal;
+pub mod viewport;
 
 pub use algorithm::{AlgorithmId, Family, Pipeline};
 pub use camera::{Camera, View};
@@ -38,3 +39,4 @@ pub use prepared::PreparedScene;
 pub use render::{RenderError, RenderOutput, RenderRequest, render};
 pub use scene::{Scene, SceneError};
 pub use stats::{Hashes, Stats};
+pub use viewport::Viewport;

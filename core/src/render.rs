@@ -6,9 +6,10 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::algorithm::{self, AlgorithmId};
-use crate::camera::{Camera, CameraError, View};
+use crate::camera::{Camera, CameraError, View, Viewport};
 use crate::framebuffer::Framebuffer;
 use crate::prepared::PreparedScene;
+use crate::request::FieldError;
 use crate::shade::shade;
 use crate::stats::{CoverageHistogram, Hashes, Stats};
 
@@ -33,6 +34,15 @@ pub struct RenderRequest {
 pub struct RenderError {
     pub field: &'static str,
     pub message: String,
+}
+
+impl From<FieldError> for RenderError {
+    fn from(e: FieldError) -> Self {
+        RenderError {
+            field: e.field,
+            message: e.message,
+        }
+    }
 }
 
 impl From<CameraError> for RenderError {
@@ -115,10 +125,20 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
 
     let mut pipeline = request.algorithm.pipeline();
     if let Some(text) = &request.oracles {
-        pipeline = pipeline.with_oracles(text).map_err(|e| RenderError {
-            field: e.field,
-            message: e.message,
-        })?;
+        pipeline = pipeline.with_oracles(text)?;
+    }
+    if !pipeline.serves(&view.viewport) {
+        return Err(view.viewport.unsupported(request.algorithm).into());
+    }
+    if pipeline.samples().is_some_and(|s| s.incremental) && view.viewport != Viewport::Parabolic {
+        return Err(FieldError::new(
+            "oracles",
+            format!(
+                "incremental: the double-incremental scheme serves the parabolic viewport only, not {}",
+                view.viewport.kind()
+            ),
+        )
+        .into());
     }
     algorithm::run(pipeline, scene, &view, &mut fb, &mut stats);
 
@@ -136,7 +156,7 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
     stats.time_ms.total = total.elapsed().as_secs_f64() * 1e3;
     Ok(RenderOutput {
         algorithm: request.algorithm,
-        viewport: format!("perspective:{}", request.camera.fov_y_deg),
+        viewport: request.camera.viewport.to_string(),
         aa: "none".into(),
         view,
         framebuffer: fb,

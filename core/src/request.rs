@@ -7,7 +7,7 @@ use glam::Vec3;
 use serde::Deserialize;
 
 use crate::algorithm::AlgorithmId;
-use crate::camera::Camera;
+use crate::camera::{Camera, Viewport};
 use crate::render::MAX_DIMENSION;
 use crate::scene::Scene;
 
@@ -50,29 +50,11 @@ pub fn parse_algorithm(s: &str) -> Result<AlgorithmId, FieldError> {
     AlgorithmId::from_str(s).map_err(|e| FieldError::new("algorithm", e.to_string()))
 }
 
-/// Parses a viewport. For now only the pinhole: `perspective` (the camera's own
-/// field of view) or `perspective:FOV` (vertical, degrees). Returns the field of
-/// view override.
-pub fn parse_viewport(s: &str) -> Result<Option<f32>, FieldError> {
-    let (kind, arg) = s.split_once(':').map_or((s, None), |(k, a)| (k, Some(a)));
-    match (kind, arg) {
-        ("perspective", None) => Ok(None),
-        ("perspective", Some(a)) => match a.parse::<f32>() {
-            Ok(fov) if fov > 0.0 && fov < 180.0 => Ok(Some(fov)),
-            _ => Err(FieldError::new(
-                "viewport",
-                format!("'{a}' is not a field of view in (0, 180) degrees"),
-            )),
-        },
-        ("orthographic" | "parabolic" | "latlong", _) => Err(FieldError::new(
-            "viewport",
-            format!("'{s}' is not supported yet; supported: perspective, perspective:FOV"),
-        )),
-        _ => Err(FieldError::new(
-            "viewport",
-            format!("unknown viewport '{s}'; supported: perspective, perspective:FOV"),
-        )),
-    }
+/// Parses a viewport for `camera` (see [`Viewport::parse`]): bare `perspective`
+/// keeps a perspective camera's field of view, bare `orthographic` an
+/// orthographic camera's height.
+pub fn parse_viewport(s: &str, camera: &Camera) -> Result<Viewport, FieldError> {
+    Viewport::parse(s, camera.viewport)
 }
 
 /// Parses an anti-aliasing mode. Only `none` exists so far.
@@ -95,6 +77,7 @@ pub enum CameraSpec {
 }
 
 /// `{ "eye": [x,y,z], "target": [x,y,z], "up": [x,y,z], "fov_y": 60, "near": 0.01 }`
+/// (a perspective camera; a request's `viewport` can change that).
 #[derive(Clone, Debug, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ExplicitCamera {
@@ -127,7 +110,7 @@ impl CameraSpec {
                 eye: Vec3::from(c.eye),
                 target: Vec3::from(c.target),
                 up: Vec3::from(c.up),
-                fov_y_deg: c.fov_y,
+                viewport: Viewport::Perspective { fov_y_deg: c.fov_y },
                 near: c.near,
             },
         };

@@ -14,6 +14,9 @@ use crate::scene::LightKind;
 /// Background colour (sRGB).
 pub const BACKGROUND_COLOR: [u8; 4] = [24, 24, 28, 255];
 
+/// Colour of pixels the viewport casts no ray through (outside the parabolic disc).
+pub const OUTSIDE_VIEWPORT_COLOR: [u8; 4] = [0, 0, 0, 255];
+
 /// Share of the base colour that is lit regardless of the light direction.
 const AMBIENT: f32 = 0.12;
 
@@ -28,13 +31,17 @@ pub fn shade(scene: &PreparedScene, view: &View, fb: &mut Framebuffer) {
         .for_each(|(y, row)| {
             for (x, out) in row.iter_mut().enumerate() {
                 let i = y * width + x;
+                let Some((origin, dir)) = view.ray(pixel_center(x as u32), pixel_center(y as u32))
+                else {
+                    *out = OUTSIDE_VIEWPORT_COLOR;
+                    continue;
+                };
                 let id = ids[i];
                 if id == BACKGROUND {
                     *out = BACKGROUND_COLOR;
                     continue;
                 }
-                let dir = view.direction(pixel_center(x as u32), pixel_center(y as u32));
-                let point = view.eye + dir * depth[i];
+                let point = origin + dir * depth[i];
                 // Direction towards the light and its colour.
                 let (to_light, light_color) = match light {
                     None => (-dir.normalize(), Vec3::ONE),

@@ -97,6 +97,11 @@ pub struct RasterCounters {
     pub tiles_accepted: u64,
     /// Blocks found wholly outside.
     pub tiles_rejected: u64,
+    /// Blocks the test could not decide, refined into four.
+    pub tiles_refined: u64,
+    /// Refined blocks that turned out to hold no sample the triangle covers
+    /// (needless refinements; with early-z, also blocks it then found hidden).
+    pub tiles_refined_empty: u64,
     /// Blocks (or boxes) skipped because the hierarchical w-buffer hides them.
     pub early_z_rejects: u64,
     /// Frusta the traversal created (the initial ones included).
@@ -114,6 +119,8 @@ impl std::ops::AddAssign for RasterCounters {
         self.tiles_tested += o.tiles_tested;
         self.tiles_accepted += o.tiles_accepted;
         self.tiles_rejected += o.tiles_rejected;
+        self.tiles_refined += o.tiles_refined;
+        self.tiles_refined_empty += o.tiles_refined_empty;
         self.early_z_rejects += o.early_z_rejects;
         self.frusta_created += o.frusta_created;
         self.frusta_split += o.frusta_split;

@@ -189,27 +189,41 @@ impl<'a> Traversal<'a> {
         }
     }
 
-    /// Is the box wholly outside one of the frustum's side planes (through the eye
-    /// and the pixel borders of `f`), or nearer than `near`?
+    /// Is the box wholly outside one of the frustum's side planes (at the pixel
+    /// borders of `f`: through the eye under perspective, parallel to the view
+    /// axis under orthographic projection), or nearer than `near`?
     fn is_outside(&self, f: PixelRect, b: &NodeBox) -> bool {
         let v = self.view;
         let (fw, right, up) = (v.forward, v.right, v.up);
-        // Image x of a point is (c.x / c.z / tan_x + 1)·W/2; border lines at the
-        // rect's pixel edges (half a pixel beyond its outermost samples).
-        let kx = |x: u32| (2.0 * x as f32 / v.width as f32 - 1.0) * v.tan_half_x;
-        let ky = |y: u32| (1.0 - 2.0 * y as f32 / v.height as f32) * v.tan_half_y;
-        let planes = [
-            right - fw * kx(f.x0),     // x ≥ left border
-            fw * kx(f.x1 + 1) - right, // x ≤ right border
-            fw * ky(f.y0) - up,        // y ≥ top border (image y down)
-            up - fw * ky(f.y1 + 1),    // y ≤ bottom border
-        ];
+        // Image x of a camera-space point is (x/w / half_x + 1)·W/2 (orthographic:
+        // x instead of x/w); border lines at the rect's pixel edges (half a pixel
+        // beyond its outermost samples).
+        let kx = |x: u32| (2.0 * x as f32 / v.width as f32 - 1.0) * v.half_x;
+        let ky = |y: u32| (1.0 - 2.0 * y as f32 / v.height as f32) * v.half_y;
+        let (left, right_border) = (kx(f.x0), kx(f.x1 + 1));
+        let (top, bottom) = (ky(f.y0), ky(f.y1 + 1));
+        // Each plane as n·(p − eye) ≥ offset.
+        let planes = if v.is_orthographic() {
+            [
+                (right, left),
+                (-right, -right_border),
+                (-up, -top),
+                (up, bottom),
+            ]
+        } else {
+            [
+                (right - fw * left, 0.0),
+                (fw * right_border - right, 0.0),
+                (fw * top - up, 0.0),
+                (up - fw * bottom, 0.0),
+            ]
+        };
         let eye = Vec3A::from(v.eye);
-        let outside_plane = |n: Vec3| {
+        let outside_plane = |(n, offset): (Vec3, f32)| {
             let n = Vec3A::from(n);
             // The corner furthest along n.
             let corner = Vec3A::select(n.cmpge(Vec3A::ZERO), b.hi, b.lo);
-            (corner - eye).dot(n) < 0.0
+            (corner - eye).dot(n) < offset
         };
         if planes.into_iter().any(outside_plane) {
             return true;
@@ -232,11 +246,17 @@ impl<'a> Traversal<'a> {
             (f.x0 + f.x1 + 1) as f32 * 0.5,
             (f.y0 + f.y1 + 1) as f32 * 0.5,
         );
-        if !SlabRay::new(v.eye, v.direction(cx, cy)).hits(b.lo, b.hi, f32::INFINITY) {
+        let (origin, direction) = (v.origin(cx, cy), v.direction(cx, cy));
+        if !SlabRay::new(origin, direction).hits(b.lo, b.hi, f32::INFINITY) {
             return true;
         }
-        // Projected size of the box in pixels at its nearest distance.
-        let pixels_per_unit = v.height as f32 / (2.0 * v.tan_half_y * b.min_w.max(v.near));
+        // Projected size of the box in pixels (perspective: at its nearest distance).
+        let image_height = if v.is_orthographic() {
+            2.0 * v.half_y
+        } else {
+            2.0 * v.half_y * b.min_w.max(v.near)
+        };
+        let pixels_per_unit = v.height as f32 / image_height;
         let extent = (b.hi - b.lo).length() * pixels_per_unit;
         extent < w.max(h) as f32 * 0.5
     }

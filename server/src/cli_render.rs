@@ -25,9 +25,10 @@ pub struct RenderArgs {
     /// outside=on,occluded=on,split=8,binning=on,early_z=off,frustum=256,leaf=8.
     #[arg(long)]
     oracles: Option<String>,
-    /// Viewport: perspective (the camera's field of view) or perspective:FOV.
-    #[arg(long, default_value = "perspective")]
-    viewport: String,
+    /// Viewport: perspective[:FOV], orthographic[:HEIGHT], parabolic or latlong
+    /// (default: the camera's own; bare words keep its field of view or height).
+    #[arg(long)]
+    viewport: Option<String>,
     /// Anti-aliasing mode (only `none` so far).
     #[arg(long, default_value = "none")]
     aa: String,
@@ -49,8 +50,6 @@ pub struct RenderArgs {
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
-    let fov_override =
-        parse_viewport(&args.viewport).map_err(|e| CliError::Usage(format!("--{e}")))?;
     parse_aa(&args.aa).map_err(|e| CliError::Usage(format!("--{e}")))?;
     let scene =
         continuum::scene::load_named_or_path(&args.scene, &scenes_dir(args.scenes.as_ref()))
@@ -61,8 +60,9 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             .map_err(|e| CliError::Usage(format!("--camera: {e}")))?,
         None => scene.first_camera(),
     };
-    if let Some(fov) = fov_override {
-        camera.fov_y_deg = fov;
+    if let Some(text) = &args.viewport {
+        camera.viewport =
+            parse_viewport(text, &camera).map_err(|e| CliError::Usage(format!("--{e}")))?;
     }
     for w in &scene.warnings {
         eprintln!("warning: {w}");

@@ -11,7 +11,7 @@ use base64::Engine;
 use continuum::request::{
     CameraSpec, FieldError, parse_aa, parse_algorithm, parse_size, parse_viewport,
 };
-use continuum::{AlgorithmId, RenderOutput, RenderRequest, maps};
+use continuum::{AlgorithmId, RenderOutput, RenderRequest, Viewport, maps};
 use serde::Deserialize;
 use serde_json::{Value, json};
 
@@ -41,7 +41,7 @@ struct Checked {
     algorithm: AlgorithmId,
     oracles: Option<String>,
     camera: Option<CameraSpec>,
-    fov_override: Option<f32>,
+    viewport: Option<String>,
     size: (u32, u32),
 }
 
@@ -69,12 +69,14 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
         )
         .into());
     }
-    let fov_override = body
-        .viewport
-        .as_deref()
-        .map(parse_viewport)
-        .transpose()?
-        .flatten();
+    if let Some(text) = &body.viewport {
+        // The words and the pairing now; bare `orthographic` takes its height
+        // from the camera, resolved when the scene is loaded.
+        let viewport = Viewport::parse(text, Viewport::Orthographic { height: 1.0 })?;
+        if !viewport.serves(algorithm) {
+            return Err(viewport.unsupported(algorithm).into());
+        }
+    }
     body.aa.as_deref().map(parse_aa).transpose()?;
     // Every mode that exists so far takes one sample per pixel.
     let samples_per_pixel = 1;
@@ -110,7 +112,7 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
         algorithm,
         oracles: body.oracles.clone(),
         camera: body.camera.clone(),
-        fov_override,
+        viewport: body.viewport.clone(),
         size,
     })
 }
@@ -134,8 +136,8 @@ async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, 
         let _permit = permit;
         let prepared = job_state.prepared(&c.scene)?;
         let mut camera = CameraSpec::resolve(c.camera.as_ref(), &prepared.scene)?;
-        if let Some(fov) = c.fov_override {
-            camera.fov_y_deg = fov;
+        if let Some(text) = &c.viewport {
+            camera.viewport = parse_viewport(text, &camera)?;
         }
         let request = RenderRequest {
             algorithm: c.algorithm,
@@ -262,7 +264,12 @@ pub async fn scenes(State(state): State<Arc<AppState>>) -> Result<Json<Value>, A
                         .map(|c| {
                             json!({
                                 "name": c.name, "eye": c.eye.to_array(), "target": c.target.to_array(),
-                                "up": c.up.to_array(), "fov_y": c.fov_y_deg, "near": c.near,
+                                "up": c.up.to_array(), "viewport": c.viewport.to_string(),
+                                "fov_y": match c.viewport {
+                                    Viewport::Perspective { fov_y_deg } => Some(fov_y_deg),
+                                    _ => None,
+                                },
+                                "near": c.near,
                             })
                         })
                         .collect();
@@ -294,7 +301,11 @@ pub async fn algorithms() -> Json<Value> {
                 "id": a.as_str(),
                 "family": a.family(),
                 "description": a.description(),
-                "viewports": ["perspective"],
+                "viewports": Viewport::KINDS
+                    .iter()
+                    .filter(|v| v.serves(*a))
+                    .map(Viewport::kind)
+                    .collect::<Vec<_>>(),
                 "takes_oracles": a.pipeline() != continuum::Pipeline::Rays,
                 "aa": ["none"],
             })

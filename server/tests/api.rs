@@ -270,7 +270,11 @@ fn bad_input_is_a_4xx_naming_the_field() {
             "size",
         ),
         (
-            r#"{ "scene": "box", "algorithm": "raycast", "viewport": "orthographic:10" }"#,
+            r#"{ "scene": "box", "algorithm": "3dr-full", "viewport": "latlong" }"#,
+            "viewport",
+        ),
+        (
+            r#"{ "scene": "box", "algorithm": "raycast", "viewport": "orthographic:-1" }"#,
             "viewport",
         ),
         (

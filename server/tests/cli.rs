@@ -199,6 +199,18 @@ fn bad_arguments_exit_2_naming_the_argument() {
                 "--scene",
                 "box",
                 "--algorithm",
+                "2dr-bin",
+                "--viewport",
+                "parabolic",
+            ],
+            "--viewport",
+        ),
+        (
+            &[
+                "render",
+                "--scene",
+                "box",
+                "--algorithm",
                 "raycast",
                 "--aa",
                 "msaa:3",

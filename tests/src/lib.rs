@@ -127,6 +127,9 @@ fn pixel_geometry(
     y: f64,
 ) -> PixelGeometry {
     let p = scene.triangles[id as usize].map(|v| v.as_dvec3());
+    if view.is_orthographic() {
+        return pixel_geometry_orthographic(view, p, x, y);
+    }
     let e = view.eye.as_dvec3();
     let (dx, dy) = (view.dx.as_dvec3(), view.dy.as_dvec3());
     let d = view.direction_f64(x, y);
@@ -146,6 +149,34 @@ fn pixel_geometry(
     PixelGeometry {
         edge_distance,
         near_distance: f.abs() / grad,
+        w,
+    }
+}
+
+/// [`pixel_geometry`] for parallel rays `o(x, y) + t·d_p`: edge functions
+/// `(d_p × (a − b))·(m − o)` and `w = N·(p0 − o) / (N·d_p)`.
+fn pixel_geometry_orthographic(
+    view: &continuum::View,
+    p: [glam::DVec3; 3],
+    x: f64,
+    y: f64,
+) -> PixelGeometry {
+    let (ox, oy) = (view.ox.as_dvec3(), view.oy.as_dvec3());
+    let o = view.o0.as_dvec3() + ox * x + oy * y;
+    let dp = view.forward.as_dvec3();
+    let gradient_of = |k: glam::DVec3| (k.dot(ox).powi(2) + k.dot(oy).powi(2)).sqrt();
+    let mut edge_distance = f64::INFINITY;
+    for i in 0..3 {
+        let (a, b) = (p[(i + 1) % 3], p[(i + 2) % 3]);
+        let n = dp.cross(a - b);
+        edge_distance = edge_distance.min(n.dot((a + b) * 0.5 - o).abs() / gradient_of(n));
+    }
+    let normal = (p[1] - p[0]).cross(p[2] - p[0]);
+    let w = normal.dot(p[0] - o) / normal.dot(dp);
+    let grad = gradient_of(normal) / normal.dot(dp).abs();
+    PixelGeometry {
+        edge_distance,
+        near_distance: (w - f64::from(view.near)).abs() / grad,
         w,
     }
 }

@@ -26,7 +26,8 @@ use serde::{Serialize, Serializer};
 
 pub use crate::binning::SampleOracles;
 
-use crate::camera::View;
+use crate::camera::{View, Viewport};
+use crate::edge::{CurvedTriangle, Triangle3D};
 use crate::framebuffer::Framebuffer;
 use crate::prepared::PreparedScene;
 use crate::request::FieldError;
@@ -203,7 +204,7 @@ impl AlgorithmId {
 
 impl Pipeline {
     /// Applies explicit oracle settings, `key=value` pairs separated by commas:
-    /// `outside`, `occluded`, `binning`, `early_z` (`on`/`off`), `split`
+    /// `outside`, `occluded`, `binning`, `early_z`, `incremental` (`on`/`off`), `split`
     /// (`off` or a size in pixels), `frustum` and `leaf` (sizes in pixels). The
     /// traversal keys need a BVH algorithm; the ray caster takes none.
     pub fn with_oracles(self, text: &str) -> Result<Pipeline, FieldError> {
@@ -231,6 +232,7 @@ impl Pipeline {
             };
             match key {
                 "binning" => samples.binning = switch()?,
+                "incremental" => samples.incremental = switch()?,
                 "early_z" => samples.early_z = switch()?,
                 "leaf" => samples.leaf = size()?,
                 "outside" | "occluded" | "split" | "frustum" => {
@@ -248,12 +250,35 @@ impl Pipeline {
                 }
                 _ => {
                     return Err(bad(format!(
-                        "unknown oracle '{key}'; oracles are: outside, occluded, split, frustum, binning, early_z, leaf"
+                        "unknown oracle '{key}'; oracles are: outside, occluded, split, frustum, binning, early_z, leaf, incremental"
                     )));
                 }
             }
         }
         Ok(p)
+    }
+
+    /// Can this pipeline render `viewport`? Straight edges (the 2D family) and
+    /// planar frusta (the BVH traversal) need a planar viewport; 3D edge
+    /// functions over all triangles and the ray caster serve every viewport.
+    pub fn serves(self, viewport: &Viewport) -> bool {
+        viewport.is_planar()
+            || matches!(
+                self,
+                Pipeline::AllTriangles {
+                    edges: EdgeKind::ThreeD,
+                    ..
+                } | Pipeline::Rays
+            )
+    }
+
+    /// How samples are enumerated (`None` for the ray caster).
+    pub fn samples(self) -> Option<SampleOracles> {
+        match self {
+            Pipeline::AllTriangles { samples, .. } => Some(samples),
+            Pipeline::Frusta(t) => Some(t.samples),
+            Pipeline::Rays => None,
+        }
     }
 
     /// The paper's Fig. 10 scalar instruction costs: (setup, per sample).
@@ -272,7 +297,8 @@ impl Pipeline {
     }
 }
 
-/// Runs `pipeline`, filling visibility buffers and counters.
+/// Runs `pipeline`, filling visibility buffers and counters. The viewport must
+/// be one the pipeline [serves](Pipeline::serves).
 pub(crate) fn run(
     pipeline: Pipeline,
     scene: &PreparedScene,
@@ -294,6 +320,13 @@ pub(crate) fn run(
                     stats,
                     start,
                 ),
+                EdgeKind::ThreeD if view.sphere.is_some() => {
+                    let mut items = setup3d::setup_curved(scene, view);
+                    if samples.incremental {
+                        items.iter_mut().for_each(|p| p.tri.incremental = true);
+                    }
+                    timed_tiles(&items, fb, samples, stats, start)
+                }
                 EdgeKind::ThreeD => {
                     timed_tiles(&setup3d::setup_3d(scene, view), fb, samples, stats, start)
                 }
@@ -321,7 +354,10 @@ pub(crate) fn run(
             stats.counters = counters;
             stats.time_ms.traversal = start.elapsed().as_secs_f64() * 1e3;
         }
-        Pipeline::Rays => raycast::render_raycast(scene, view, fb, stats),
+        Pipeline::Rays if view.sphere.is_some() => {
+            raycast::render_raycast(scene, view, fb, stats, CurvedTriangle::setup);
+        }
+        Pipeline::Rays => raycast::render_raycast(scene, view, fb, stats, Triangle3D::setup),
     }
 }
 

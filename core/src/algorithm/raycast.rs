@@ -8,8 +8,10 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
+use glam::Vec3;
+
 use crate::camera::{View, pixel_center};
-use crate::edge::{Coverage, Triangle3D};
+use crate::edge::Coverage;
 use crate::framebuffer::{BACKGROUND, Framebuffer, wins_depth_test};
 use crate::prepared::PreparedScene;
 use crate::stats::Stats;
@@ -22,18 +24,21 @@ const CULL_MARGIN: f32 = 1.0 + 1.0 / 1024.0;
 
 const BAND_ROWS: u32 = 4;
 
-pub(crate) fn render_raycast(
+/// Casts one ray per pixel; `setup` gives the same triangles the 3D rasterizers
+/// of this viewport use.
+pub(crate) fn render_raycast<T: Coverage + Send + Sync>(
     scene: &PreparedScene,
     view: &View,
     fb: &mut Framebuffer,
     stats: &mut Stats,
+    setup: impl Fn(&[Vec3; 3], &View) -> Option<T> + Sync,
 ) {
     // 1. Setup: the 3D edge functions of every drawable triangle for this view.
     let start = Instant::now();
-    let setups: Vec<Option<Triangle3D>> = scene
+    let setups: Vec<Option<T>> = scene
         .slot_triangles
         .par_iter()
-        .map(|&id| Triangle3D::setup(&scene.triangles[id as usize], view))
+        .map(|&id| setup(&scene.triangles[id as usize], view))
         .collect();
     stats.triangle_setups = setups.iter().filter(|s| s.is_some()).count() as u64;
     stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
@@ -51,7 +56,11 @@ pub(crate) fn render_raycast(
                     let xc = pixel_center(x);
                     let (mut best_w, mut best_id) = (f32::INFINITY, BACKGROUND);
                     let (mut evals, mut covered) = (0u32, 0u32);
-                    nodes += scene.bvh.walk(view.eye, view.direction(xc, yc), |k| {
+                    // No ray outside the viewport (the parabolic disc): background.
+                    let Some((origin, direction)) = view.ray(xc, yc) else {
+                        continue;
+                    };
+                    nodes += scene.bvh.walk(origin, direction, |k| {
                         if let Some(tri) = &setups[k as usize] {
                             evals += 1;
                             if let Some(w) = tri.sample(xc, yc) {

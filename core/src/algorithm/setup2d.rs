@@ -14,7 +14,8 @@ use crate::prepared::PreparedScene;
 /// Every drawable triangle, clipped, projected and set up; pieces without
 /// samples on screen are dropped.
 pub(crate) fn setup_2d(scene: &PreparedScene, view: &View) -> Vec<Placed<Triangle2D>> {
-    let planes = pipeline_planes(view.near, view.tan_half_x, view.tan_half_y);
+    let planes = pipeline_planes(view);
+    let affine = view.is_orthographic();
     scene
         .drawable
         .par_iter()
@@ -33,20 +34,21 @@ pub(crate) fn setup_2d(scene: &PreparedScene, view: &View) -> Vec<Placed<Triangl
             let mut screen = [ScreenVertex {
                 x: 0.0,
                 y: 0.0,
-                inv_w: 0.0,
+                q: 0.0,
             }; crate::clip::MAX_CLIPPED];
             for (s, c) in screen.iter_mut().zip(poly.as_slice()) {
                 let (x, y) = view.project(*c);
                 *s = ScreenVertex {
                     x,
                     y,
-                    inv_w: 1.0 / c.z,
+                    q: if affine { c.z } else { 1.0 / c.z },
                 };
             }
             // 3. Fan-triangulate and set up each piece.
             for k in 1..poly.len - 1 {
                 let Some(tri) = Triangle2D::setup(
                     &[screen[0], screen[k], screen[k + 1]],
+                    affine,
                     view.width,
                     view.height,
                 ) else {

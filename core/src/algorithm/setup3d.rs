@@ -9,12 +9,18 @@ use super::PixelRect;
 use super::tiles::Placed;
 use crate::camera::View;
 use crate::clip::{ClipPlane, clip_triangle};
-use crate::edge::{self, Triangle3D};
+use crate::edge::{self, CurvedTriangle, Triangle3D};
 use crate::prepared::PreparedScene;
 
 /// Every drawable triangle with samples on screen, set up with 3D edge functions.
 pub(crate) fn setup_3d(scene: &PreparedScene, view: &View) -> Vec<Placed<Triangle3D>> {
     setup_visible(scene, view, Triangle3D::setup)
+}
+
+/// Every drawable triangle with samples on a non-planar viewport, set up with 3D
+/// edge functions evaluated per sample direction (paper §3.5).
+pub(crate) fn setup_curved(scene: &PreparedScene, view: &View) -> Vec<Placed<CurvedTriangle>> {
+    setup_visible(scene, view, CurvedTriangle::setup)
 }
 
 /// Every drawable triangle with samples on screen, set up for homogeneous 2D
@@ -23,11 +29,11 @@ pub(crate) fn setup_homogeneous(scene: &PreparedScene, view: &View) -> Vec<Place
     setup_visible(scene, view, edge::setup_homogeneous)
 }
 
-fn setup_visible(
+fn setup_visible<T: Send>(
     scene: &PreparedScene,
     view: &View,
-    setup: impl Fn(&[Vec3; 3], &View) -> Option<Triangle3D> + Sync,
-) -> Vec<Placed<Triangle3D>> {
+    setup: impl Fn(&[Vec3; 3], &View) -> Option<T> + Sync,
+) -> Vec<Placed<T>> {
     scene
         .drawable
         .par_iter()
@@ -47,7 +53,20 @@ fn setup_visible(
 /// vertices (clipped at slightly less than `near` where the triangle reaches
 /// nearer) projected, padded by 1/16 pixel plus a relative 2⁻¹⁶ so that rounding
 /// in the projection never cuts off a sample the 3D edge functions cover.
+/// Non-planar viewports: the bounds of the triangle's cap of directions
+/// ([`crate::camera::SphereMap::bounds_of`]), padded by a pixel.
 pub(crate) fn screen_rect(p: &[Vec3; 3], view: &View) -> Option<PixelRect> {
+    if let Some(map) = &view.sphere {
+        let [x0, y0, x1, y1] = map.bounds_of(&p.map(|v| view.to_camera_f64(v)));
+        return PixelRect::from_bounds(
+            (x0 - 1.0) as f32,
+            (y0 - 1.0) as f32,
+            (x1 + 1.0) as f32,
+            (y1 + 1.0) as f32,
+            view.width,
+            view.height,
+        );
+    }
     let near_bound = view.near * (1.0 - 1.0 / 1024.0);
     let cam = [
         view.to_camera(p[0]),

@@ -6,14 +6,15 @@
 //! apply opposite signs, so a sample on the edge goes to exactly one of them; a
 //! sample exactly on a vertex gets `E = 0` exactly on both of its edges.
 
-use super::{Coverage, owns_tie};
+use super::{BlockTest, Coverage, LinearEdges, linear_classify, linear_sample, owns_tie};
 
-/// A projected vertex: pixel coordinates and `1/w` for perspective-correct depth.
+/// A projected vertex: pixel coordinates and the depth quantity that is linear in
+/// the image: `1/w` under perspective, `w` itself under orthographic projection.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ScreenVertex {
     pub x: f32,
     pub y: f32,
-    pub inv_w: f32,
+    pub q: f32,
 }
 
 /// A projected triangle set up for 2D rasterization.
@@ -26,8 +27,10 @@ pub struct Triangle2D {
     /// ±1: the edge's sign for this triangle (canonical order × orientation).
     sign: [f32; 3],
     pub owns: [bool; 3],
-    /// `1/w` at each vertex.
-    inv_w: [f32; 3],
+    /// The image-linear depth quantity at each vertex (see [`ScreenVertex::q`]).
+    q: [f32; 3],
+    /// `q` is `w` (orthographic) rather than `1/w`.
+    affine: bool,
     /// Smallest and largest vertex `w`: sample depths are clamped into it.
     w_range: [f32; 2],
     /// Per edge, a bound on the rounding error of an evaluation on the image.
@@ -39,14 +42,21 @@ pub struct Triangle2D {
 impl Triangle2D {
     /// Sets up the three edge functions; `None` for triangles that are degenerate
     /// in f32 after projection (some vertex not strictly inside its opposite edge).
-    pub fn setup(v: &[ScreenVertex; 3], width: u32, height: u32) -> Option<Triangle2D> {
-        let w = v.map(|s| 1.0 / s.inv_w);
+    /// `affine`: the vertices' `q` is `w` (orthographic), not `1/w`.
+    pub fn setup(
+        v: &[ScreenVertex; 3],
+        affine: bool,
+        width: u32,
+        height: u32,
+    ) -> Option<Triangle2D> {
+        let w = v.map(|s| if affine { s.q } else { 1.0 / s.q });
         let mut t = Triangle2D {
             lo: [[0.0; 2]; 3],
             delta: [[0.0; 2]; 3],
             sign: [1.0; 3],
             owns: [false; 3],
-            inv_w: [v[0].inv_w, v[1].inv_w, v[2].inv_w],
+            q: [v[0].q, v[1].q, v[2].q],
+            affine,
             w_range: [w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2])],
             error: [0.0; 3],
             bounds: [
@@ -107,6 +117,26 @@ impl Triangle2D {
 }
 
 impl Coverage for Triangle2D {
+    #[inline(always)]
+    fn sample(&self, x: f32, y: f32) -> Option<f32> {
+        linear_sample(self, x, y)
+    }
+
+    #[inline(always)]
+    fn depth_inside(&self, x: f32, y: f32) -> Option<f32> {
+        self.depth(self.edge_values(x, y), x, y)
+    }
+
+    fn classify_block(&self, x0: f32, y0: f32, x1: f32, y1: f32) -> BlockTest {
+        linear_classify(self, x0, y0, x1, y1)
+    }
+
+    fn min_depth(&self) -> f32 {
+        self.w_range[0]
+    }
+}
+
+impl LinearEdges for Triangle2D {
     /// The three signed edge values at pixel point `(x, y)`.
     #[inline(always)]
     fn edge_values(&self, x: f32, y: f32) -> [f32; 3] {
@@ -123,21 +153,17 @@ impl Coverage for Triangle2D {
     }
 
     /// Perspective-correct depth: `1/w = Σ λ_i / w_i`, `λ_i = E_i / ΣE` (paper
-    /// §3.1), clamped to the vertices' range.
+    /// §3.1); orthographic: `w = Σ λ_i w_i`. Clamped to the vertices' range.
     #[inline(always)]
     fn depth(&self, e: [f32; 3], _x: f32, _y: f32) -> Option<f32> {
         let sum = e[0] + e[1] + e[2];
-        let inv_w = e[0] * self.inv_w[0] + e[1] * self.inv_w[1] + e[2] * self.inv_w[2];
-        let w = sum / inv_w;
+        let q = e[0] * self.q[0] + e[1] * self.q[1] + e[2] * self.q[2];
+        let w = if self.affine { q / sum } else { sum / q };
         // max/min rather than clamp: never panics, equal for ordered bounds.
         (w > 0.0 && w < f32::INFINITY).then(|| w.max(self.w_range[0]).min(self.w_range[1]))
     }
 
     fn edge_error(&self) -> [f32; 3] {
         self.error
-    }
-
-    fn min_depth(&self) -> f32 {
-        self.w_range[0]
     }
 }

@@ -5,12 +5,17 @@
 //! edge get bitwise negated normals in f32, so they split every sample on it.
 //! With a sample direction `d(x, y) = d0 + x·dx + y·dy` the edge function is
 //! `V(x, y) = n·d = A + x·B + y·C` with `A = n·d0`, `B = n·dx`, `C = n·dy`.
+//!
+//! Orthographic views (§3.3) cast parallel rays `o(x, y) + t·d_p`; the edge
+//! normal is `n = d_p × (a − b)` and the edge function `V = n·(m − o(x, y))`
+//! with `m` the edge midpoint — the same triple product `[o − m, a − b, d]` as
+//! the perspective one with the eye replaced by the ray origin, again linear.
 
 use glam::Vec3;
 
 use wide::f32x8;
 
-use super::{Coverage, owns_tie};
+use super::{BlockTest, Coverage, LinearEdges, linear_classify, linear_sample, owns_tie};
 use crate::camera::View;
 
 /// A triangle set up for 3D rasterization against one view: per edge `i`
@@ -32,8 +37,9 @@ pub struct Triangle3D {
     pub a: [f32; 3],
     pub b: [f32; 3],
     pub c: [f32; 3],
-    /// `|D|`: `w = |D| / (N·d)`.
-    pub volume: f32,
+    /// `|D|` as a linear function of the image point: `w = volume(x, y) / (N·d)`.
+    /// Perspective: the constant `|D|`; orthographic: `N·(p0 − o(x, y))`.
+    pub volume: [f32; 3],
     /// `N·d(x, y) = nd[0] + x·nd[1] + y·nd[2]`, sign-normalised like the edges.
     pub nd: [f32; 3],
     /// Per edge: does it own samples exactly on it (the §3.4 tie rule)?
@@ -66,6 +72,9 @@ impl Triangle3D {
     /// triangle is seen exactly edge-on (`D = 0`) or the values are not finite.
     #[inline]
     pub fn setup(p: &[Vec3; 3], view: &View) -> Option<Triangle3D> {
+        if view.is_orthographic() {
+            return Self::setup_orthographic(p, view);
+        }
         let eye = view.eye;
         // 1. Total volume D = N · (p0 − e) with the geometric normal N; its sign is
         //    the side the eye sees, and it orients the edge functions.
@@ -80,16 +89,43 @@ impl Triangle3D {
         let edges =
             [0, 1, 2].map(|i| along(edge_normal(eye, p[(i + 1) % 3], p[(i + 2) % 3]) * sign));
         let w = p.map(|v| (v - eye).dot(view.forward));
-        Triangle3D::from_linear(edges, along(normal * sign), d.abs(), w, view)
+        Triangle3D::from_linear(edges, along(normal * sign), [d.abs(), 0.0, 0.0], w, view)
+    }
+
+    /// Paper §3.3: orthographic setup, `n_i = d_p × (p_{i+1} − p_{i+2})` and
+    /// `V_i = n_i · (m_i − o(x, y))`; the depth `w = N·(p0 − o(x, y)) / (N·d_p)`.
+    /// `None` when the triangle is seen edge-on (`N·d_p = 0`).
+    pub fn setup_orthographic(p: &[Vec3; 3], view: &View) -> Option<Triangle3D> {
+        let dp = view.forward;
+        let normal = (p[1] - p[0]).cross(p[2] - p[0]);
+        let facing = normal.dot(dp);
+        if facing == 0.0 || !facing.is_finite() {
+            return None;
+        }
+        let sign = if facing > 0.0 { 1.0 } else { -1.0 };
+        // k·(q − o(x, y)) = k·(q − o0) − x·k·ox − y·k·oy.
+        let toward = |k: Vec3, q: Vec3| [k.dot(q - view.o0), -k.dot(view.ox), -k.dot(view.oy)];
+        let edges = [0, 1, 2].map(|i| {
+            let (a, b) = (p[(i + 1) % 3], p[(i + 2) % 3]);
+            toward(dp.cross(a - b) * sign, (a + b) * 0.5)
+        });
+        let w = p.map(|v| (v - view.eye).dot(dp));
+        Triangle3D::from_linear(
+            edges,
+            [facing.abs(), 0.0, 0.0],
+            toward(normal * sign, p[0]),
+            w,
+            view,
+        )
     }
 
     /// Assembles a triangle from its three sign-normalised edge functions, the
-    /// depth denominator `N·d` (so `w = volume / (N·d)`), and its vertices' `w`:
-    /// derives the tie rule and the error bounds. `None` on non-finite values.
+    /// depth as a ratio of linear functions `w = volume / nd`, and its vertices'
+    /// `w`: derives the tie rule and the error bounds. `None` on non-finite values.
     pub fn from_linear(
         edges: [Linear; 3],
         nd: Linear,
-        volume: f32,
+        volume: Linear,
         vertex_w: [f32; 3],
         view: &View,
     ) -> Option<Triangle3D> {
@@ -116,14 +152,14 @@ impl Triangle3D {
             .iter()
             .flatten()
             .chain(&nd)
-            .chain(&[volume])
+            .chain(&volume)
             .chain(&t.w_range)
             .all(|v| v.is_finite());
         finite.then_some(t)
     }
 }
 
-impl Coverage for Triangle3D {
+impl LinearEdges for Triangle3D {
     /// The three edge values at image point `(x, y)`: `(A + x·B) + y·C`.
     #[inline(always)]
     fn edge_values(&self, x: f32, y: f32) -> [f32; 3] {
@@ -146,15 +182,30 @@ impl Coverage for Triangle3D {
         if facing <= 0.0 {
             return None;
         }
+        let volume = self.volume[0] + x * self.volume[1] + y * self.volume[2];
         // max/min rather than clamp: never panics, and the 8-lane path rounds alike.
-        let w = (self.volume / facing)
-            .max(self.w_range[0])
-            .min(self.w_range[1]);
+        let w = (volume / facing).max(self.w_range[0]).min(self.w_range[1]);
         (w >= self.near).then_some(w)
     }
 
     fn edge_error(&self) -> [f32; 3] {
         self.error
+    }
+}
+
+impl Coverage for Triangle3D {
+    #[inline(always)]
+    fn sample(&self, x: f32, y: f32) -> Option<f32> {
+        linear_sample(self, x, y)
+    }
+
+    #[inline(always)]
+    fn depth_inside(&self, x: f32, y: f32) -> Option<f32> {
+        self.depth(self.edge_values(x, y), x, y)
+    }
+
+    fn classify_block(&self, x0: f32, y0: f32, x1: f32, y1: f32) -> BlockTest {
+        linear_classify(self, x0, y0, x1, y1)
     }
 
     /// Eight samples side by side (8 lanes, `wide`): the scalar operations of
@@ -182,7 +233,10 @@ impl Coverage for Triangle3D {
         if mask == 0 {
             return (0, [0.0; 8]);
         }
-        let w = (f32x8::splat(self.volume) / facing)
+        let volume = f32x8::splat(self.volume[0])
+            + x * f32x8::splat(self.volume[1])
+            + y * f32x8::splat(self.volume[2]);
+        let w = (volume / facing)
             .fast_max(f32x8::splat(self.w_range[0]))
             .fast_min(f32x8::splat(self.w_range[1]));
         let mask = mask & w.simd_ge(f32x8::splat(self.near)).to_bitmask() as u8;
@@ -209,7 +263,7 @@ mod tests {
             eye: Vec3::new(0.3, -0.2, 4.0),
             target: Vec3::new(0.0, 0.1, 0.0),
             up: Vec3::Y,
-            fov_y_deg: 60.0,
+            viewport: crate::camera::Viewport::Perspective { fov_y_deg: 60.0 },
             near: Some(0.05),
         };
         let view = View::new(&camera, 64, 48, 0.01).unwrap();

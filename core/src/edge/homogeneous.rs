@@ -16,15 +16,19 @@ use crate::camera::View;
 
 /// Setup of Fig. 10 (middle): transform, three cross products, determinant.
 /// `None` when the determinant is zero (degenerate or seen edge-on).
+/// Orthographic views have `W = 1` at every vertex, and `w` is interpolated
+/// linearly: `w = Σ w_i·E_i / ΣE_i`.
 pub fn setup_homogeneous(p: &[Vec3; 3], view: &View) -> Option<Triangle3D> {
     // 1. Camera space → homogeneous pixel coordinates (X, Y, W), x = X/W.
     let (half_w, half_h) = (view.width as f32 * 0.5, view.height as f32 * 0.5);
-    let h = p.map(|v| {
-        let c = view.to_camera(v);
+    let orthographic = view.is_orthographic();
+    let cam = p.map(|v| view.to_camera(v));
+    let h = cam.map(|c| {
+        let w = if orthographic { 1.0 } else { c.z };
         Vec3::new(
-            (c.x / view.tan_half_x + c.z) * half_w,
-            (c.z - c.y / view.tan_half_y) * half_h,
-            c.z,
+            (c.x / view.half_x + w) * half_w,
+            (w - c.y / view.half_y) * half_h,
+            w,
         )
     });
     // 2. Edge functions: rows of the adjugate, c_i = h_{i+1} × h_{i+2}, written as
@@ -43,11 +47,16 @@ pub fn setup_homogeneous(p: &[Vec3; 3], view: &View) -> Option<Triangle3D> {
     }
     let sign = if det > 0.0 { 1.0 } else { -1.0 };
     let linear = |r: Vec3| [r.z * sign, r.x * sign, r.y * sign];
+    let volume = if orthographic {
+        linear(rows[0] * cam[0].z + rows[1] * cam[1].z + rows[2] * cam[2].z)
+    } else {
+        [det.abs(), 0.0, 0.0]
+    };
     Triangle3D::from_linear(
         rows.map(linear),
         linear(normal),
-        det.abs(),
-        h.map(|v| v.z),
+        volume,
+        cam.map(|c| c.z),
         view,
     )
 }

@@ -3,14 +3,18 @@
 //! - [`Triangle3D`]: the Plücker / signed-volume edge functions of paper
 //!   §3.2, evaluated per sample with no projection.
 //! - [`Triangle2D`]: projected 2D edge functions (paper §3.1).
+//! - [`CurvedTriangle`]: 3D edge functions against the per-sample directions of
+//!   a non-planar viewport (paper §3.5).
 //!
 //! Both decide a sample that lies exactly on an edge with the same top-left rule
 //! ([`owns_tie`]), so every sample of a closed mesh is covered exactly once.
 
+mod curved;
 mod edge2d;
 mod edge3d;
 mod homogeneous;
 
+pub use curved::CurvedTriangle;
 pub use edge2d::{ScreenVertex, Triangle2D};
 pub use edge3d::Triangle3D;
 pub use homogeneous::setup_homogeneous;
@@ -32,27 +36,23 @@ pub fn inside_edge(e: f32, owns: bool) -> bool {
     e > 0.0 || (e == 0.0 && owns)
 }
 
+/// Where a block of samples stands against one triangle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BlockTest {
+    /// No sample of the block is covered.
+    Outside,
+    /// Every sample of the block is inside all three edges.
+    Inside,
+    /// Undecided: refine.
+    Partial,
+}
+
 /// A triangle set up for one view, as every coverage loop sees it. `sample` is
 /// the single decision all algorithms of a family share: edge values in one fixed
 /// operation order, the tie rule, then depth.
 pub trait Coverage {
-    /// The three edge values at image point `(x, y)`, positive inside.
-    fn edge_values(&self, x: f32, y: f32) -> [f32; 3];
-
-    /// Per edge: does it own samples exactly on it?
-    fn owns(&self) -> [bool; 3];
-
-    /// Depth `w` of the sample at `(x, y)` with edge values `edges`, or `None`
-    /// when the sample is rejected (nearer than `near`, or not in front).
-    fn depth(&self, edges: [f32; 3], x: f32, y: f32) -> Option<f32>;
-
-    /// Per edge, a bound on how far two evaluations of [`Coverage::edge_values`]
-    /// at points of the image can be off their exact values; binning rejects or
-    /// accepts a block only beyond it.
-    fn edge_error(&self) -> [f32; 3];
-
-    /// No sample of the triangle has a smaller depth than this.
-    fn min_depth(&self) -> f32;
+    /// Coverage and depth of the sample at `(x, y)`.
+    fn sample(&self, x: f32, y: f32) -> Option<f32>;
 
     /// Coverage and depth of eight samples in a row, at `x0, x0 + 1, …, x0 + 7`:
     /// a bit mask of the covered ones and their depths. Bit for bit what
@@ -71,15 +71,92 @@ pub trait Coverage {
         (mask, depth)
     }
 
-    /// Coverage and depth of the sample at `(x, y)`.
+    /// Coverage of the `n` samples `(x0 + k, y)`, `k < n`: calls `hit(k, w)` for
+    /// each covered one. The same decisions as [`Coverage::sample`] per sample.
     #[inline(always)]
-    fn sample(&self, x: f32, y: f32) -> Option<f32> {
-        let e = self.edge_values(x, y);
-        let o = self.owns();
-        if inside_edge(e[0], o[0]) && inside_edge(e[1], o[1]) && inside_edge(e[2], o[2]) {
-            self.depth(e, x, y)
-        } else {
-            None
+    fn sample_run(&self, x0: f32, y: f32, n: u32, mut hit: impl FnMut(u32, f32)) {
+        let mut k = 0;
+        // Eight samples at a time, then the rest one by one.
+        while k + 8 <= n {
+            let (mask, depth) = self.sample8(x0 + k as f32, y);
+            let mut covered = mask;
+            while covered != 0 {
+                let b = covered.trailing_zeros();
+                covered &= covered - 1;
+                hit(k + b, depth[b as usize]);
+            }
+            k += 8;
         }
+        for k in k..n {
+            if let Some(w) = self.sample(x0 + k as f32, y) {
+                hit(k, w);
+            }
+        }
+    }
+
+    /// Depth of a sample of a block that [`Coverage::classify_block`] found
+    /// inside; `None` when the depth test rejects it (nearer than `near`).
+    fn depth_inside(&self, x: f32, y: f32) -> Option<f32>;
+
+    /// Conservative test of the block of samples with corner samples `(x0, y0)`
+    /// and `(x1, y1)` (binning, paper §3.1, and for curved edges §3.5).
+    fn classify_block(&self, x0: f32, y0: f32, x1: f32, y1: f32) -> BlockTest;
+
+    /// No sample of the triangle has a smaller depth than this.
+    fn min_depth(&self) -> f32;
+}
+
+/// Edge functions linear in the image point (planar viewports): the parts from
+/// which [`Coverage`] is assembled by [`linear_sample`] and [`linear_classify`].
+pub trait LinearEdges {
+    /// The three edge values at image point `(x, y)`, positive inside.
+    fn edge_values(&self, x: f32, y: f32) -> [f32; 3];
+
+    /// Per edge: does it own samples exactly on it?
+    fn owns(&self) -> [bool; 3];
+
+    /// Depth `w` of the sample at `(x, y)` with edge values `edges`, or `None`
+    /// when the sample is rejected (nearer than `near`, or not in front).
+    fn depth(&self, edges: [f32; 3], x: f32, y: f32) -> Option<f32>;
+
+    /// Per edge, a bound on how far two evaluations of [`LinearEdges::edge_values`]
+    /// at points of the image can be off their exact values; binning rejects or
+    /// accepts a block only beyond it.
+    fn edge_error(&self) -> [f32; 3];
+}
+
+/// Coverage and depth of one sample: edge values, the tie rule, then depth.
+#[inline(always)]
+pub fn linear_sample<T: LinearEdges>(t: &T, x: f32, y: f32) -> Option<f32> {
+    let e = t.edge_values(x, y);
+    let o = t.owns();
+    if inside_edge(e[0], o[0]) && inside_edge(e[1], o[1]) && inside_edge(e[2], o[2]) {
+        t.depth(e, x, y)
+    } else {
+        None
+    }
+}
+
+/// Straight edges at the block's four corner samples: outside if some edge is
+/// negative beyond its error bound at all four, inside if every edge is positive
+/// beyond it at all four (paper §3.1, "binning").
+#[inline]
+pub fn linear_classify<T: LinearEdges>(t: &T, x0: f32, y0: f32, x1: f32, y1: f32) -> BlockTest {
+    let errors = t.edge_error();
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for (x, y) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1)] {
+        let e = t.edge_values(x, y);
+        for k in 0..3 {
+            lo[k] = lo[k].min(e[k]);
+            hi[k] = hi[k].max(e[k]);
+        }
+    }
+    if (0..3).any(|k| hi[k] < -errors[k]) {
+        BlockTest::Outside
+    } else if (0..3).all(|k| lo[k] > errors[k]) {
+        BlockTest::Inside
+    } else {
+        BlockTest::Partial
     }
 }

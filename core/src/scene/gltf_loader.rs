@@ -12,7 +12,7 @@ use super::validate::{PartLocation, validate_part};
 use super::{
     ImageRef, ImageSource, Light, LightKind, Material, Mesh, Scene, SceneError, TextureRef,
 };
-use crate::camera::Camera;
+use crate::camera::{Camera, Viewport};
 
 /// Loads a `.gltf` or `.glb` file; external buffers resolve next to it.
 pub fn load_gltf(path: &Path) -> Result<Scene, SceneError> {
@@ -155,23 +155,38 @@ fn read_document(
                 .name()
                 .map(str::to_string)
                 .unwrap_or_else(|| format!("camera{}", cam.index()));
-            match cam.projection() {
-                gltf::camera::Projection::Perspective(p) => {
-                    let eye = world.transform_point3(Vec3::ZERO);
-                    let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
-                    let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
-                    scene.cameras.push(Camera {
-                        name,
-                        eye,
-                        target: eye + forward,
-                        up,
+            let (viewport, near) = match cam.projection() {
+                gltf::camera::Projection::Perspective(p) => (
+                    Viewport::Perspective {
                         fov_y_deg: p.yfov().to_degrees(),
-                        near: Some(p.znear()),
-                    });
-                }
-                gltf::camera::Projection::Orthographic(_) => scene.warnings.push(format!(
-                    "camera '{name}' is orthographic; orthographic viewports are not supported yet, skipped"
-                )),
+                    },
+                    p.znear(),
+                ),
+                // ymag is half the view's height.
+                gltf::camera::Projection::Orthographic(o) => (
+                    Viewport::Orthographic {
+                        height: 2.0 * o.ymag(),
+                    },
+                    o.znear(),
+                ),
+            };
+            let eye = world.transform_point3(Vec3::ZERO);
+            let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+            let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
+            let camera = Camera {
+                name,
+                eye,
+                target: eye + forward,
+                up,
+                viewport,
+                // glTF allows znear = 0 for orthographic cameras; ours must be positive.
+                near: (near > 0.0).then_some(near),
+            };
+            match camera.validate() {
+                Ok(()) => scene.cameras.push(camera),
+                Err(e) => scene
+                    .warnings
+                    .push(format!("camera '{}' skipped: {e}", camera.name)),
             }
         }
         if let Some(light) = node.light() {

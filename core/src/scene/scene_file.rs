@@ -18,6 +18,7 @@
 //! target = [0, 0.1, 0]
 //! up = [0, 1, 0]                 # default
 //! fov_y = 60                     # degrees, default 60
+//! viewport = "perspective:60"    # optional: perspective[:FOV], orthographic:HEIGHT, parabolic, latlong
 //! near = 0.001                   # optional
 //!
 //! [[light]]
@@ -44,7 +45,7 @@ use serde::Deserialize;
 
 use super::procedural::Generator;
 use super::{Light, LightKind, Material, Scene, SceneError, load_path};
-use crate::camera::Camera;
+use crate::camera::{Camera, Viewport};
 
 /// The parsed TOML document.
 #[derive(Clone, Debug, Deserialize)]
@@ -90,16 +91,16 @@ pub struct CameraEntry {
     pub target: [f32; 3],
     #[serde(default = "up")]
     pub up: [f32; 3],
-    #[serde(default = "fov")]
-    pub fov_y: f32,
+    /// Vertical field of view of a perspective camera, degrees.
+    pub fov_y: Option<f32>,
+    /// A viewport in the CLI's words (`perspective:60`, `orthographic:10`,
+    /// `parabolic`, `latlong`); default perspective with `fov_y`.
+    pub viewport: Option<String>,
     pub near: Option<f32>,
 }
 
 fn up() -> [f32; 3] {
     [0.0, 1.0, 0.0]
-}
-fn fov() -> f32 {
-    60.0
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -271,12 +272,20 @@ fn build(doc: &SceneFile, file: &str, name: String, dir: &Path) -> Result<Scene,
     // 3. Cameras and lights of the scene file come first.
     let mut cameras = Vec::new();
     for c in &doc.camera {
+        let perspective = Viewport::Perspective {
+            fov_y_deg: c.fov_y.unwrap_or(60.0),
+        };
+        let viewport = match &c.viewport {
+            None => perspective,
+            Some(text) => Viewport::parse(text, perspective)
+                .map_err(|e| err(format!("camera '{}': {e}", c.name)))?,
+        };
         let camera = Camera {
             name: c.name.clone(),
             eye: Vec3::from(c.eye),
             target: Vec3::from(c.target),
             up: Vec3::from(c.up),
-            fov_y_deg: c.fov_y,
+            viewport,
             near: c.near,
         };
         camera

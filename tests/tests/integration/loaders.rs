@@ -216,7 +216,7 @@ fn degenerate_triangles_load_but_are_never_drawn() {
         eye: Vec3::new(0.0, 0.0, 3.0),
         target: Vec3::ZERO,
         up: Vec3::Y,
-        fov_y_deg: 60.0,
+        viewport: continuum::Viewport::Perspective { fov_y_deg: 60.0 },
         near: None,
     };
     let positions = vec![
@@ -272,7 +272,10 @@ fn gltf_cameras_lights_materials_and_transforms_load() {
     assert_eq!(scene.mesh.positions[0], glam::Vec3::new(10.0, 0.0, 0.0));
     let camera = scene.camera("shot").expect("the glTF camera by name");
     assert_eq!(camera.eye, glam::Vec3::new(0.5, 0.5, 4.0));
-    assert!((camera.fov_y_deg - 0.5f32.to_degrees()).abs() < 1e-4);
+    let continuum::Viewport::Perspective { fov_y_deg } = camera.viewport else {
+        panic!("a perspective camera, got {}", camera.viewport);
+    };
+    assert!((fov_y_deg - 0.5f32.to_degrees()).abs() < 1e-4);
     assert_eq!(camera.near, Some(0.05));
     assert_eq!(scene.lights.len(), 1);
     // The light's node is a child of the mesh node: it inherits the translation.

@@ -4,4 +4,5 @@ mod agreement;
 mod loaders;
 mod oracles;
 mod tie_rules;
+mod viewports;
 mod watertight;

@@ -15,7 +15,7 @@ fn exact_camera() -> Camera {
         eye: Vec3::ZERO,
         target: Vec3::NEG_Z,
         up: Vec3::Y,
-        fov_y_deg: 90.0,
+        viewport: continuum::Viewport::Perspective { fov_y_deg: 90.0 },
         near: Some(0.01),
     }
 }
