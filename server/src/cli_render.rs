@@ -25,7 +25,7 @@ pub struct RenderArgs {
     /// outside=on,occluded=on,split=8,binning=on,early_z=off,frustum=256,leaf=8.
     #[arg(long)]
     oracles: Option<String>,
-    /// Viewport: perspective[:FOV], orthographic[:HEIGHT], parabolic or latlong
+    /// Viewport: `perspective[:FOV]`, `orthographic[:HEIGHT]`, `parabolic` or `latlong`
     /// (default: the camera's own; bare words keep its field of view or height).
     #[arg(long)]
     viewport: Option<String>,

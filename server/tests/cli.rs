@@ -81,6 +81,37 @@ fn render_json_has_the_documented_keys() {
 }
 
 #[test]
+fn render_takes_every_viewport() {
+    // The orthographic rays start inside the sphere too: the image is 1 × 0.5 units.
+    for viewport in ["perspective:40", "orthographic:0.5", "parabolic", "latlong"] {
+        let out = continuum(&[
+            "render",
+            "--scene",
+            "sphere",
+            "--camera",
+            "inside",
+            "--algorithm",
+            "3dr-bin",
+            "--viewport",
+            viewport,
+            "--size",
+            "64x32",
+            "--json",
+        ]);
+        assert!(
+            out.status.success(),
+            "{viewport}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let doc: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+        assert_eq!(doc["viewport"], viewport);
+        // Inside the closed sphere every sample with a ray is covered once.
+        assert!(doc["stats"]["coverage_histogram"]["one"].as_u64() > Some(700));
+        assert_eq!(doc["stats"]["coverage_histogram"]["many"], 0, "{viewport}");
+    }
+}
+
+#[test]
 fn render_writes_the_image_and_maps() {
     let dir = out_dir("maps");
     let png = dir.join("bunny.png");

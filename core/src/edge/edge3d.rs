@@ -50,7 +50,7 @@ pub struct Triangle3D {
     pub w_range: [f32; 2],
     /// Samples nearer than this are rejected.
     pub near: f32,
-    /// Per edge: a bound on the rounding error of [`Coverage::edge_values`] anywhere
+    /// Per edge: a bound on the rounding error of [`LinearEdges::edge_values`] anywhere
     /// on the image (for conservative binning).
     pub error: [f32; 3],
 }
@@ -209,7 +209,7 @@ impl Coverage for Triangle3D {
     }
 
     /// Eight samples side by side (8 lanes, `wide`): the scalar operations of
-    /// [`Coverage::edge_values`], the tie rule and [`Coverage::depth`], lane by lane.
+    /// [`LinearEdges::edge_values`], the tie rule and [`LinearEdges::depth`], lane by lane.
     #[inline(always)]
     fn sample8(&self, x0: f32, y: f32) -> (u8, [f32; 8]) {
         let x = f32x8::splat(x0) + f32x8::from([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);

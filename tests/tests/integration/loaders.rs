@@ -289,3 +289,36 @@ fn gltf_cameras_lights_materials_and_transforms_load() {
     assert_eq!(scene.materials[0].base_color, [0.1, 0.2, 0.3, 1.0]);
     assert!(scene.mesh.material_ids.iter().all(|&m| m == 0));
 }
+
+#[test]
+fn scene_file_cameras_may_name_a_viewport() {
+    let toml = |viewport: &str| {
+        format!(
+            "[[mesh]]\ngenerator = \"sphere\"\n\n\
+             [[camera]]\nname = \"pano\"\neye = [0, 0, 0.1]\ntarget = [0, 0, -1]\nviewport = \"{viewport}\"\n\n\
+             [[camera]]\nname = \"plain\"\neye = [0, 0, 5]\ntarget = [0, 0, 0]\nfov_y = 35\n"
+        )
+    };
+    let path = temp_file("viewports.toml", toml("latlong").as_bytes());
+    let scene = load_path(&path).expect("loads");
+    let camera = |name: &str| scene.camera(name).expect("camera").viewport;
+    assert_eq!(camera("pano"), continuum::Viewport::LatLong);
+    assert_eq!(
+        camera("plain"),
+        continuum::Viewport::Perspective { fov_y_deg: 35.0 }
+    );
+    let path = temp_file("ortho.toml", toml("orthographic:4").as_bytes());
+    assert_eq!(
+        load_path(&path)
+            .expect("loads")
+            .camera("pano")
+            .expect("camera")
+            .viewport,
+        continuum::Viewport::Orthographic { height: 4.0 }
+    );
+    let msg = load_err("fisheye.toml", toml("fisheye").as_bytes());
+    assert!(
+        msg.contains("camera 'pano'") && msg.contains("viewport") && msg.contains("latlong"),
+        "{msg}"
+    );
+}
