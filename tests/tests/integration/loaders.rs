@@ -255,13 +255,17 @@ fn every_index_width_loads() {
 #[test]
 fn gltf_cameras_lights_materials_and_transforms_load() {
     let (mut json, bin) = triangle_gltf(&QUAD, &[0, 1, 2, 0, 2, 3], 5123, 4);
-    json["scenes"][0]["nodes"] = serde_json::json!([0, 1]);
+    json["scenes"][0]["nodes"] = serde_json::json!([0, 1, 3]);
     json["nodes"] = serde_json::json!([
         { "mesh": 0, "translation": [10.0, 0.0, 0.0], "children": [2] },
         { "camera": 0, "name": "cam", "translation": [0.5, 0.5, 4.0] },
-        { "extensions": { "KHR_lights_punctual": { "light": 0 } }, "translation": [0.0, 3.0, 0.0] }
+        { "extensions": { "KHR_lights_punctual": { "light": 0 } }, "translation": [0.0, 3.0, 0.0] },
+        { "camera": 1, "translation": [0.0, 0.0, 9.0] }
     ]);
-    json["cameras"] = serde_json::json!([{ "name": "shot", "type": "perspective", "perspective": { "yfov": 0.5, "znear": 0.05, "aspectRatio": 1.5 } }]);
+    json["cameras"] = serde_json::json!([
+        { "name": "shot", "type": "perspective", "perspective": { "yfov": 0.5, "znear": 0.05, "aspectRatio": 1.5 } },
+        { "name": "flat", "type": "orthographic", "orthographic": { "xmag": 2.0, "ymag": 1.5, "znear": 0.0, "zfar": 100.0 } }
+    ]);
     json["extensionsUsed"] = serde_json::json!(["KHR_lights_punctual"]);
     json["extensions"] = serde_json::json!({ "KHR_lights_punctual": { "lights": [{ "type": "point", "color": [1.0, 0.5, 0.25], "intensity": 7.0 }] } });
     json["materials"] = serde_json::json!([{ "name": "paint", "pbrMetallicRoughness": { "baseColorFactor": [0.1, 0.2, 0.3, 1.0] } }]);
@@ -276,6 +280,16 @@ fn gltf_cameras_lights_materials_and_transforms_load() {
         panic!("a perspective camera, got {}", camera.viewport);
     };
     assert!((fov_y_deg - 0.5f32.to_degrees()).abs() < 1e-4);
+    // Orthographic: ymag is half the height; znear = 0 leaves the scene's default.
+    let flat = scene.camera("flat").expect("the orthographic camera");
+    assert_eq!(
+        flat.viewport,
+        continuum::Viewport::Orthographic { height: 3.0 }
+    );
+    assert_eq!(
+        (flat.eye, flat.near),
+        (glam::Vec3::new(0.0, 0.0, 9.0), None)
+    );
     assert_eq!(camera.near, Some(0.05));
     assert_eq!(scene.lights.len(), 1);
     // The light's node is a child of the mesh node: it inherits the translation.
