@@ -117,6 +117,9 @@ impl CurvedTriangle {
                 + e.z.abs() * (0.5 + 0.5 * (u_max * u_max + v * v))
         });
         const STEP_ERROR: f64 = 64.0 * f64::EPSILON;
+        // The second differences are constant along the row.
+        let curvature = self.n.map(|e| e.z * h * h * 0.5);
+        let slope_step = self.n.map(|e| e.z * h);
         for j in 0..n {
             let x = x0 + j as f32;
             let xf = f64::from(x);
@@ -131,8 +134,8 @@ impl CurvedTriangle {
                     let d = *direction.get_or_insert_with(|| self.map.direction(xf, yf));
                     d.is_some_and(|d| self.inside_edge(k, d, xf, yf))
                 };
-                value[k] += h * slope[k] - self.n[k].z * h * h * 0.5;
-                slope[k] -= self.n[k].z * h;
+                value[k] += h * slope[k] - curvature[k];
+                slope[k] -= slope_step[k];
             }
             if inside
                 && let Some(d) = direction.unwrap_or_else(|| self.map.direction(xf, yf))
