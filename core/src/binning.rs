@@ -7,9 +7,8 @@
 //! possible depth lies behind everything the hierarchical w-buffer holds there.
 
 use crate::algorithm::PixelRect;
-use crate::camera::pixel_center;
 use crate::edge::{BlockTest, Coverage};
-use crate::framebuffer::TileBuffer;
+use crate::framebuffer::{SCRATCH_PIXELS, TileBuffer};
 use crate::stats::RasterCounters;
 
 /// How samples are enumerated inside a triangle's box.
@@ -106,17 +105,22 @@ fn early_z_rejects<T: Coverage>(
 }
 
 /// Tests every sample of `r` (per-sample coverage, the leaf of every strategy);
-/// returns how many are covered.
+/// returns how many coverage samples the triangle covers.
 #[inline]
 fn test_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRect) -> u32 {
+    if tile.pattern.coverage() > 1 {
+        return sample_pattern(tile, tri, id, r, Samples::Test);
+    }
+    // One sample per pixel: runs along rows (which curved edges may evaluate
+    // incrementally, §3.5 eq. 3).
     let mut covered = 0;
+    let n = r.x1 - r.x0 + 1;
     for y in r.y0..=r.y1 {
         let i = tile.index(r.x0, y);
-        let n = r.x1 - r.x0 + 1;
         for count in &mut tile.edge_evals[i..i + n as usize] {
             *count += 1;
         }
-        tri.sample_run(pixel_center(r.x0), pixel_center(y), n, |k, w| {
+        tri.sample_run(r.x0 as f32 + 0.5, y as f32 + 0.5, n, |k, w| {
             covered += 1;
             tile.write(i + k as usize, w, id);
         });
@@ -125,25 +129,106 @@ fn test_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRe
 }
 
 /// Writes every sample of `r`, known to be inside the edges: only depth is
-/// computed. Returns the number of samples written.
+/// computed (with its `near` test). Returns the number of samples written.
 #[inline]
 fn fill_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRect) -> u32 {
-    let mut written = 0;
+    sample_pattern(tile, tri, id, r, Samples::Inside)
+}
+
+/// What [`sample_pattern`] evaluates per sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Samples {
+    /// Edges, tie rule and depth ([`Coverage::sample_points8`]).
+    Test,
+    /// Depth only, the block being inside ([`Coverage::depth_inside8`]).
+    Inside,
+}
+
+/// Every coverage position of every pixel of `r`, eight samples at a time:
+/// along a row, lane `l` of group `g` is position `c` of pixel `k` with
+/// `k·C + c = 8g + l`, so small patterns share a group between pixels. Covered
+/// stored samples go through the depth test; under CSAA a stored sample that
+/// wins keeps the triangle's mask over all positions of its pixel.
+fn sample_pattern<T: Coverage>(
+    tile: &mut TileBuffer,
+    tri: &T,
+    id: u32,
+    r: PixelRect,
+    how: Samples,
+) -> u32 {
+    // Rows in chunks of at most CHUNK pixels (the CSAA scratch's size).
+    const CHUNK: u32 = SCRATCH_PIXELS as u32;
+    let pattern = tile.pattern;
+    let (positions, stored, pixels) = (&pattern.positions, pattern.stored, tile.pixels);
+    let count = positions.len();
+    let shift = count.trailing_zeros();
+    let masked = pattern.has_coverage_only();
+    // CSAA scratch per chunk: each pixel's mask, and the depths at its stored
+    // positions (row `s` of `depths` for stored position `s`).
+    let mut masks = std::mem::take(&mut tile.scratch_masks);
+    let mut depths = std::mem::take(&mut tile.scratch_depths);
+    let mut covered = 0;
     for y in r.y0..=r.y1 {
-        let yc = pixel_center(y);
-        for x in r.x0..=r.x1 {
-            let i = tile.index(x, y);
-            tile.edge_evals[i] += 1;
-            if let Some(w) = tri.depth_inside(pixel_center(x), yc) {
-                written += 1;
-                tile.write(i, w, id);
+        for x0 in (r.x0..=r.x1).step_by(CHUNK as usize) {
+            let n = (r.x1 - x0 + 1).min(CHUNK) as usize;
+            let i = tile.index(x0, y);
+            for evals in &mut tile.edge_evals[i..i + n] {
+                *evals += count as u32;
+            }
+            if masked {
+                masks[..n].fill(0);
+            }
+            let total = n << shift;
+            for q in (0..total).step_by(8) {
+                let lanes = (total - q).min(8);
+                let (mut xs, mut ys) = ([0.0; 8], [0.0; 8]);
+                for l in 0..8 {
+                    // Spare lanes repeat the last sample; their bits are dropped.
+                    let p = q + l.min(lanes - 1);
+                    let [ox, oy] = positions[p & (count - 1)];
+                    xs[l] = (x0 + (p >> shift) as u32) as f32 + ox;
+                    ys[l] = y as f32 + oy;
+                }
+                let (mask, w) = match how {
+                    Samples::Test => tri.sample_points8(xs, ys),
+                    Samples::Inside => tri.depth_inside8(xs, ys),
+                };
+                let mut mask = u32::from(mask) & ((1 << lanes) - 1);
+                covered += mask.count_ones();
+                while mask != 0 {
+                    let l = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let (k, c) = ((q + l) >> shift, (q + l) & (count - 1));
+                    if masked {
+                        masks[k] |= 1 << c;
+                        if c < stored {
+                            depths[c * CHUNK as usize + k] = w[l];
+                        }
+                    } else {
+                        tile.write(c * pixels + i + k, w[l], id);
+                    }
+                }
+            }
+            if masked {
+                for (k, &mask) in masks[..n].iter().enumerate() {
+                    let mut at_stored = mask & ((1 << stored) - 1);
+                    while at_stored != 0 {
+                        let s = at_stored.trailing_zeros() as usize;
+                        at_stored &= at_stored - 1;
+                        let w = depths[s * CHUNK as usize + k];
+                        tile.write_masked(s * pixels + i + k, w, id, mask);
+                    }
+                }
             }
         }
     }
-    written
+    tile.scratch_masks = masks;
+    tile.scratch_depths = depths;
+    covered
 }
 
-/// The triangle's block test at the four corner samples of `r` (paper §3.1:
+/// The triangle's block test over every sample of `r`: the corners of the box
+/// of its samples (pixel corners plus the pattern's span; paper §3.1:
 /// "binning"; curved edges §3.5), each corner pixel charged one evaluation.
 #[inline]
 fn test_block<T: Coverage>(tile: &mut TileBuffer, tri: &T, r: PixelRect) -> BlockTest {
@@ -151,11 +236,12 @@ fn test_block<T: Coverage>(tile: &mut TileBuffer, tri: &T, r: PixelRect) -> Bloc
         let i = tile.index(x, y);
         tile.edge_evals[i] += 1;
     }
+    let span = tile.pattern.span;
     tri.classify_block(
-        pixel_center(r.x0),
-        pixel_center(r.y0),
-        pixel_center(r.x1),
-        pixel_center(r.y1),
+        r.x0 as f32 + span.lo[0],
+        r.y0 as f32 + span.lo[1],
+        r.x1 as f32 + span.hi[0],
+        r.y1 as f32 + span.hi[1],
     )
 }
 

@@ -1,6 +1,9 @@
 //! The framebuffer: colour, w-buffer, triangle ids, and the two per-pixel counters
 //! that explain an image — edge evaluations (work) and coverage writes
-//! (watertightness: a closed mesh gives exactly one per pixel).
+//! (watertightness: a closed mesh gives exactly one per sample).
+
+use crate::aa::SamplePattern;
+use crate::stats::CoverageHistogram;
 
 /// Triangle id of a pixel no triangle covers.
 pub const BACKGROUND: u32 = u32::MAX;
@@ -13,7 +16,11 @@ pub fn wins_depth_test(w: f32, id: u32, depth: f32, stored_id: u32) -> bool {
     w < depth || (w == depth && id < stored_id)
 }
 
-/// All per-pixel buffers of one render, row-major, `y` down.
+/// All per-pixel buffers of one render, row-major, `y` down. With anti-aliasing
+/// the samples of a pixel are resolved into it: `color` is the box-filtered
+/// colour, `depth` and `triangle_id` are those of the pattern's first sample,
+/// `edge_evals` and `coverage_writes` count over all its samples, and
+/// `sample_digest` identifies the triangle ids (and coverage masks) of all of them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Framebuffer {
     pub width: u32,
@@ -26,11 +33,16 @@ pub struct Framebuffer {
     pub triangle_id: Vec<u32>,
     /// Samples-against-triangle tests made at each pixel (each evaluates three edges).
     pub edge_evals: Vec<u32>,
-    /// Samples that passed a coverage test at each pixel, before the depth test.
-    /// Algorithms with early-z or occlusion culling skip hidden blocks before
-    /// testing them, so they count fewer here (never on a closed mesh seen from
-    /// inside, where every sample has exactly one triangle).
+    /// Samples that passed a coverage test at each pixel, before the depth test,
+    /// summed over the pixel's stored samples. Algorithms with early-z or
+    /// occlusion culling skip hidden blocks before testing them, so they count
+    /// fewer here (never on a closed mesh seen from inside, where every sample has
+    /// exactly one triangle).
     pub coverage_writes: Vec<u32>,
+    /// With anti-aliasing: per pixel, a 64-bit hash of its samples' triangle ids
+    /// (and CSAA coverage masks), so renders can be compared sample by sample;
+    /// empty without anti-aliasing, where `triangle_id` is the whole story.
+    pub sample_digest: Vec<u64>,
 }
 
 impl Framebuffer {
@@ -44,83 +56,114 @@ impl Framebuffer {
             triangle_id: vec![BACKGROUND; n],
             edge_evals: vec![0; n],
             coverage_writes: vec![0; n],
+            sample_digest: Vec::new(),
         }
     }
 
-    /// Splits the buffers into horizontal bands of `rows` rows for parallel work.
-    pub fn bands_mut(&mut self, rows: u32) -> Vec<Band<'_>> {
-        let width = self.width as usize;
-        let chunk = width * rows.max(1) as usize;
-        self.depth
-            .chunks_mut(chunk)
-            .zip(self.triangle_id.chunks_mut(chunk))
-            .zip(self.edge_evals.chunks_mut(chunk))
-            .zip(self.coverage_writes.chunks_mut(chunk))
-            .enumerate()
-            .map(
-                |(i, (((depth, triangle_id), edge_evals), coverage_writes))| {
-                    let y0 = i as u32 * rows.max(1);
-                    Band {
-                        y0,
-                        y1: y0 + (depth.len() / width) as u32,
-                        width: self.width,
-                        depth,
-                        triangle_id,
-                        edge_evals,
-                        coverage_writes,
-                    }
-                },
-            )
-            .collect()
+    /// The image cut into `size × size` tiles (smaller at the right and bottom),
+    /// as `(x0, y0, x1, y1)` with exclusive ends, row by row.
+    pub fn tile_rects(&self, size: u32) -> Vec<(u32, u32, u32, u32)> {
+        let mut rects = Vec::new();
+        for y0 in (0..self.height).step_by(size as usize) {
+            for x0 in (0..self.width).step_by(size as usize) {
+                rects.push((
+                    x0,
+                    y0,
+                    (x0 + size).min(self.width),
+                    (y0 + size).min(self.height),
+                ));
+            }
+        }
+        rects
+    }
+
+    /// Copies a resolved tile into place.
+    pub(crate) fn store(&mut self, tile: &ResolvedTile) {
+        let [x0, y0, x1, y1] = tile.rect;
+        let w = (x1 - x0) as usize;
+        if !tile.sample_digest.is_empty() && self.sample_digest.is_empty() {
+            self.sample_digest = vec![0; self.color.len()];
+        }
+        for y in y0..y1 {
+            let src = (y - y0) as usize * w;
+            let dst = y as usize * self.width as usize + x0 as usize;
+            self.color[dst..dst + w].copy_from_slice(&tile.color[src..src + w]);
+            self.depth[dst..dst + w].copy_from_slice(&tile.depth[src..src + w]);
+            self.triangle_id[dst..dst + w].copy_from_slice(&tile.triangle_id[src..src + w]);
+            self.edge_evals[dst..dst + w].copy_from_slice(&tile.edge_evals[src..src + w]);
+            self.coverage_writes[dst..dst + w].copy_from_slice(&tile.coverage_writes[src..src + w]);
+            if !tile.sample_digest.is_empty() {
+                self.sample_digest[dst..dst + w].copy_from_slice(&tile.sample_digest[src..src + w]);
+            }
+        }
     }
 }
 
-/// Rows `y0..y1` of a framebuffer's visibility buffers.
-#[derive(Debug)]
-pub struct Band<'a> {
-    pub y0: u32,
-    pub y1: u32,
-    pub width: u32,
-    pub depth: &'a mut [f32],
-    pub triangle_id: &'a mut [u32],
-    pub edge_evals: &'a mut [u32],
-    pub coverage_writes: &'a mut [u32],
+/// A tile's pixels after the resolve: what [`Framebuffer::store`] copies, plus
+/// what the resolve counted.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ResolvedTile {
+    /// `[x0, y0, x1, y1]`, exclusive ends.
+    pub rect: [u32; 4],
+    pub color: Vec<[u8; 4]>,
+    pub depth: Vec<f32>,
+    pub triangle_id: Vec<u32>,
+    pub edge_evals: Vec<u32>,
+    pub coverage_writes: Vec<u32>,
+    pub sample_digest: Vec<u64>,
+    /// Coverage writes per stored sample: zero, one, many.
+    pub histogram: CoverageHistogram,
+    /// Shading evaluations made.
+    pub shading_samples: u64,
 }
 
-impl Band<'_> {
-    /// Index into the band's slices of pixel `(x, y)` (`y` in `y0..y1`).
-    #[inline(always)]
-    pub fn index(&self, x: u32, y: u32) -> usize {
-        (y - self.y0) as usize * self.width as usize + x as usize
-    }
-}
+/// Pixels of a row the coverage kernel handles at once (its CSAA scratch).
+pub(crate) const SCRATCH_PIXELS: usize = 64;
 
 /// Side of a hierarchical w-buffer cell in pixels.
 pub const HIZ_CELL: u32 = 8;
 
 /// A rectangle of the framebuffer rendered by one worker: the visibility buffers
-/// of pixels `x0..x1 × y0..y1` plus a hierarchical w-buffer holding, per
-/// [`HIZ_CELL`]² cell, the farthest depth stored in it (paper §5 "early-z").
+/// of pixels `x0..x1 × y0..y1` for every stored sample of the pattern, plus a
+/// hierarchical w-buffer holding, per [`HIZ_CELL`]² cell, the farthest depth
+/// stored in it over all samples (paper §5 "early-z").
+///
+/// Sample buffers are layer-major: stored sample `s` of pixel `i` is at
+/// `s · pixels + i`, so the samples of one position along a row are contiguous.
 #[derive(Clone, Debug)]
-pub struct TileBuffer {
+pub struct TileBuffer<'p> {
     pub x0: u32,
     pub y0: u32,
     pub x1: u32,
     pub y1: u32,
+    /// Where the samples lie in a pixel.
+    pub pattern: &'p SamplePattern,
+    /// Pixels in the tile.
+    pub pixels: usize,
     pub depth: Vec<f32>,
     pub triangle_id: Vec<u32>,
-    pub edge_evals: Vec<u32>,
+    /// Coverage writes per stored sample.
     pub coverage_writes: Vec<u32>,
-    /// Farthest depth per cell (`+∞` while any pixel of it is empty).
+    /// CSAA: per stored sample, the coverage positions its triangle covers in
+    /// the pixel (empty when every position is stored).
+    pub masks: Vec<u32>,
+    /// Per pixel: sample-against-triangle tests.
+    pub edge_evals: Vec<u32>,
+    /// CSAA scratch of the coverage kernel: masks of [`SCRATCH_PIXELS`] pixels
+    /// and the depths at their stored positions (empty otherwise).
+    pub(crate) scratch_masks: Vec<u32>,
+    pub(crate) scratch_depths: Vec<f32>,
+    /// Farthest depth per cell (`+∞` while any sample of it is empty).
     pub hiz: Vec<f32>,
     hiz_columns: u32,
     /// Has a stored depth decreased since the last [`TileBuffer::update_hiz`]?
     depth_lowered: bool,
 }
 
-impl TileBuffer {
-    pub fn new(x0: u32, y0: u32, x1: u32, y1: u32) -> TileBuffer {
-        let n = ((x1 - x0) * (y1 - y0)) as usize;
+impl<'p> TileBuffer<'p> {
+    pub fn new(x0: u32, y0: u32, x1: u32, y1: u32, pattern: &'p SamplePattern) -> TileBuffer<'p> {
+        let pixels = ((x1 - x0) * (y1 - y0)) as usize;
+        let samples = pixels * pattern.stored;
         let hiz_columns = (x1 - x0).div_ceil(HIZ_CELL);
         let hiz_rows = (y1 - y0).div_ceil(HIZ_CELL);
         TileBuffer {
@@ -128,10 +171,27 @@ impl TileBuffer {
             y0,
             x1,
             y1,
-            depth: vec![f32::INFINITY; n],
-            triangle_id: vec![BACKGROUND; n],
-            edge_evals: vec![0; n],
-            coverage_writes: vec![0; n],
+            pattern,
+            pixels,
+            depth: vec![f32::INFINITY; samples],
+            triangle_id: vec![BACKGROUND; samples],
+            coverage_writes: vec![0; samples],
+            masks: if pattern.has_coverage_only() {
+                vec![0; samples]
+            } else {
+                Vec::new()
+            },
+            edge_evals: vec![0; pixels],
+            scratch_masks: if pattern.has_coverage_only() {
+                vec![0; SCRATCH_PIXELS]
+            } else {
+                Vec::new()
+            },
+            scratch_depths: if pattern.has_coverage_only() {
+                vec![0.0; SCRATCH_PIXELS * pattern.stored]
+            } else {
+                Vec::new()
+            },
             hiz: vec![f32::INFINITY; (hiz_columns * hiz_rows) as usize],
             hiz_columns,
             depth_lowered: false,
@@ -148,22 +208,36 @@ impl TileBuffer {
         }
     }
 
-    /// Index of pixel `(x, y)` (screen coordinates) in the tile's buffers.
+    /// Index of pixel `(x, y)` (screen coordinates) in the tile's per-pixel
+    /// buffers; stored sample `s` of it is at `s · pixels + index`.
     #[inline(always)]
     pub fn index(&self, x: u32, y: u32) -> usize {
         ((y - self.y0) * (self.x1 - self.x0) + (x - self.x0)) as usize
     }
 
-    /// A covered sample: count the coverage write, then the w-buffer test with
-    /// depth ties going to the smaller triangle id.
+    /// A covered sample (index `i` into the sample buffers): count the coverage
+    /// write, then the w-buffer test with depth ties going to the smaller
+    /// triangle id. Returns whether the sample now holds the triangle.
     #[inline(always)]
-    pub fn write(&mut self, i: usize, w: f32, id: u32) {
+    pub fn write(&mut self, i: usize, w: f32, id: u32) -> bool {
         self.coverage_writes[i] += 1;
         let (d, t) = (self.depth[i], self.triangle_id[i]);
         if wins_depth_test(w, id, d, t) {
             self.depth_lowered |= w < d;
             self.depth[i] = w;
             self.triangle_id[i] = id;
+            true
+        } else {
+            false
+        }
+    }
+
+    /// [`TileBuffer::write`] for CSAA: a winner also stores the coverage mask of
+    /// its triangle in the pixel.
+    #[inline(always)]
+    pub fn write_masked(&mut self, i: usize, w: f32, id: u32, mask: u32) {
+        if self.write(i, w, id) {
+            self.masks[i] = mask;
         }
     }
 
@@ -194,46 +268,21 @@ impl TileBuffer {
             for cx in cx0..=cx1 {
                 let px0 = self.x0 + cx * HIZ_CELL;
                 let py0 = self.y0 + cy * HIZ_CELL;
+                let px1 = (px0 + HIZ_CELL).min(self.x1);
                 let mut max = f32::NEG_INFINITY;
-                for y in py0..(py0 + HIZ_CELL).min(self.y1) {
-                    for x in px0..(px0 + HIZ_CELL).min(self.x1) {
-                        max = max.max(self.depth[self.index(x, y)]);
+                // Stop at the first empty sample: nothing is farther.
+                'scan: for layer in self.depth.chunks_exact(self.pixels) {
+                    for y in py0..(py0 + HIZ_CELL).min(self.y1) {
+                        let i = self.index(px0, y);
+                        let row = &layer[i..i + (px1 - px0) as usize];
+                        max = row.iter().copied().fold(max, f32::max);
+                        if max == f32::INFINITY {
+                            break 'scan;
+                        }
                     }
                 }
                 self.hiz[(cy * self.hiz_columns + cx) as usize] = max;
             }
-        }
-    }
-}
-
-impl Framebuffer {
-    /// The image cut into `size × size` tiles (smaller at the right and bottom),
-    /// as `(x0, y0, x1, y1)` with exclusive ends, row by row.
-    pub fn tile_rects(&self, size: u32) -> Vec<(u32, u32, u32, u32)> {
-        let mut rects = Vec::new();
-        for y0 in (0..self.height).step_by(size as usize) {
-            for x0 in (0..self.width).step_by(size as usize) {
-                rects.push((
-                    x0,
-                    y0,
-                    (x0 + size).min(self.width),
-                    (y0 + size).min(self.height),
-                ));
-            }
-        }
-        rects
-    }
-
-    /// Copies a rendered tile's visibility buffers into place.
-    pub fn store(&mut self, tile: &TileBuffer) {
-        let w = (tile.x1 - tile.x0) as usize;
-        for y in tile.y0..tile.y1 {
-            let src = tile.index(tile.x0, y);
-            let dst = y as usize * self.width as usize + tile.x0 as usize;
-            self.depth[dst..dst + w].copy_from_slice(&tile.depth[src..src + w]);
-            self.triangle_id[dst..dst + w].copy_from_slice(&tile.triangle_id[src..src + w]);
-            self.edge_evals[dst..dst + w].copy_from_slice(&tile.edge_evals[src..src + w]);
-            self.coverage_writes[dst..dst + w].copy_from_slice(&tile.coverage_writes[src..src + w]);
         }
     }
 }

@@ -10,10 +10,11 @@
 //! let scene = continuum::scene::load_path("scenes/bunny.toml".as_ref()).unwrap();
 //! let prepared = PreparedScene::new(scene);
 //! let camera = prepared.scene.first_camera();
-//! let out = render(&prepared, &RenderRequest { algorithm: AlgorithmId::ThreeDBrute, oracles: None, camera, width: 640, height: 480 }).unwrap();
+//! let out = render(&prepared, &RenderRequest { algorithm: AlgorithmId::ThreeDBrute, oracles: None, camera, width: 640, height: 480, aa: Default::default() }).unwrap();
 //! println!("{}", out.hashes.triangle_id);
 //! ```
 
+pub mod aa;
 pub mod algorithm;
 pub mod binning;
 pub mod bvh;
@@ -32,6 +33,7 @@ pub mod stats;
 pub mod traversal;
 pub mod viewport;
 
+pub use aa::AaMode;
 pub use algorithm::{AlgorithmId, Family, Pipeline};
 pub use camera::{Camera, View};
 pub use framebuffer::{BACKGROUND, Framebuffer};

@@ -5,13 +5,13 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use crate::aa::AaMode;
 use crate::algorithm::{self, AlgorithmId};
 use crate::camera::{Camera, CameraError, View, Viewport};
 use crate::framebuffer::Framebuffer;
 use crate::prepared::PreparedScene;
 use crate::request::FieldError;
-use crate::shade::shade;
-use crate::stats::{CoverageHistogram, Hashes, Stats};
+use crate::stats::{Hashes, Stats};
 
 /// Largest width or height a render accepts.
 pub const MAX_DIMENSION: u32 = 16384;
@@ -26,6 +26,8 @@ pub struct RenderRequest {
     pub camera: Camera,
     pub width: u32,
     pub height: u32,
+    /// Anti-aliasing mode (sample pattern and shading rate).
+    pub aa: AaMode,
 }
 
 /// A request that cannot be rendered, with the field at fault.
@@ -122,6 +124,7 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
     )?;
     let mut fb = Framebuffer::new(request.width, request.height);
     let mut stats = Stats::default();
+    let pattern = request.aa.pattern();
 
     let mut pipeline = request.algorithm.pipeline();
     if let Some(text) = &request.oracles {
@@ -140,15 +143,14 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
         )
         .into());
     }
-    algorithm::run(pipeline, scene, &view, &mut fb, &mut stats);
-
-    let start = Instant::now();
-    shade(scene, &view, &mut fb);
-    stats.time_ms.shading = start.elapsed().as_secs_f64() * 1e3;
+    algorithm::run(pipeline, scene, &view, &pattern, &mut fb, &mut stats);
 
     stats.edge_evaluations = fb.edge_evals.iter().map(|&e| u64::from(e)).sum();
     stats.max_edge_evals_per_pixel = fb.edge_evals.iter().copied().max().unwrap_or(0);
-    stats.coverage_histogram = CoverageHistogram::of(&fb.coverage_writes);
+    let pixels = u64::from(request.width) * u64::from(request.height);
+    stats.samples_per_pixel = request.aa.coverage_samples();
+    stats.stored_samples_per_pixel = request.aa.stored_samples();
+    stats.coverage_samples = pixels * u64::from(stats.samples_per_pixel);
     let (setup_cost, sample_cost) = pipeline.instruction_costs();
     stats.predicted_instructions =
         stats.triangle_setups * setup_cost + stats.edge_evaluations * sample_cost;
@@ -157,7 +159,7 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
     Ok(RenderOutput {
         algorithm: request.algorithm,
         viewport: request.camera.viewport.to_string(),
-        aa: "none".into(),
+        aa: request.aa.to_string(),
         view,
         framebuffer: fb,
         stats,

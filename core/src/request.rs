@@ -6,6 +6,8 @@ use std::str::FromStr;
 use glam::Vec3;
 use serde::Deserialize;
 
+use crate::aa::AaMode;
+
 use crate::algorithm::AlgorithmId;
 use crate::camera::{Camera, Viewport};
 use crate::render::MAX_DIMENSION;
@@ -57,15 +59,9 @@ pub fn parse_viewport(s: &str, camera: &Camera) -> Result<Viewport, FieldError> 
     Viewport::parse(s, camera.viewport)
 }
 
-/// Parses an anti-aliasing mode. Only `none` exists so far.
-pub fn parse_aa(s: &str) -> Result<(), FieldError> {
-    match s {
-        "none" => Ok(()),
-        _ => Err(FieldError::new(
-            "aa",
-            format!("unknown or unsupported mode '{s}'; supported: none"),
-        )),
-    }
+/// Parses an anti-aliasing mode (`none`, `ssaa:N`, `msaa:N`, `csaa:CxS`).
+pub fn parse_aa(s: &str) -> Result<AaMode, FieldError> {
+    AaMode::parse(s)
 }
 
 /// A camera as a request gives it: a scene camera's name, or an explicit one.

@@ -1,15 +1,13 @@
 //! Shading of visible samples. For now: Lambert with the scene's first light (or a
 //! headlight at the eye), base colour from the material, two-sided face normals.
-//! Shading reads only the triangle id and `w` of a pixel, so algorithms that agree
-//! on those produce identical colours.
+//! Shading reads only the triangle id and `w` of a sample, so algorithms that
+//! agree on those produce identical colours. Colours are linear until the
+//! resolve ([`crate::aa`]) encodes the filtered pixel as sRGB.
 
 use glam::Vec3;
-use rayon::prelude::*;
 
-use crate::camera::{View, pixel_center};
-use crate::framebuffer::{BACKGROUND, Framebuffer};
 use crate::prepared::PreparedScene;
-use crate::scene::LightKind;
+use crate::scene::{Light, LightKind};
 
 /// Background colour (sRGB).
 pub const BACKGROUND_COLOR: [u8; 4] = [24, 24, 28, 255];
@@ -20,60 +18,52 @@ pub const OUTSIDE_VIEWPORT_COLOR: [u8; 4] = [0, 0, 0, 255];
 /// Share of the base colour that is lit regardless of the light direction.
 const AMBIENT: f32 = 0.12;
 
-/// Shades every pixel of `fb` from its triangle id and depth.
-pub fn shade(scene: &PreparedScene, view: &View, fb: &mut Framebuffer) {
-    let light = scene.scene.lights.first();
-    let width = fb.width as usize;
-    let (ids, depth) = (&fb.triangle_id, &fb.depth);
-    fb.color
-        .par_chunks_mut(width)
-        .enumerate()
-        .for_each(|(y, row)| {
-            for (x, out) in row.iter_mut().enumerate() {
-                let i = y * width + x;
-                let Some((origin, dir)) = view.ray(pixel_center(x as u32), pixel_center(y as u32))
-                else {
-                    *out = OUTSIDE_VIEWPORT_COLOR;
-                    continue;
-                };
-                let id = ids[i];
-                if id == BACKGROUND {
-                    *out = BACKGROUND_COLOR;
-                    continue;
-                }
-                let point = origin + dir * depth[i];
-                // Direction towards the light and its colour.
-                let (to_light, light_color) = match light {
-                    None => (-dir.normalize(), Vec3::ONE),
-                    Some(l) => {
-                        let to = match &l.kind {
-                            LightKind::Directional { direction } => -*direction,
-                            LightKind::Point { position } | LightKind::Spot { position, .. } => {
-                                *position - point
-                            }
-                        };
-                        (to.normalize_or_zero(), Vec3::from(l.color).min(Vec3::ONE))
+/// Shades samples of one scene.
+#[derive(Clone, Copy, Debug)]
+pub struct Shader<'a> {
+    scene: &'a PreparedScene,
+    light: Option<&'a Light>,
+}
+
+impl<'a> Shader<'a> {
+    pub fn new(scene: &'a PreparedScene) -> Shader<'a> {
+        Shader {
+            scene,
+            light: scene.scene.lights.first(),
+        }
+    }
+
+    /// Linear colour of triangle `id` seen along the ray `origin + t·dir` at
+    /// depth `depth` (the ray's own parameter: `w` on planar views, the distance
+    /// on non-planar ones).
+    #[inline]
+    pub fn shade(&self, id: u32, origin: Vec3, dir: Vec3, depth: f32) -> Vec3 {
+        let point = origin + dir * depth;
+        // Direction towards the light and its colour.
+        let (to_light, light_color) = match self.light {
+            None => (-dir.normalize(), Vec3::ONE),
+            Some(l) => {
+                let to = match &l.kind {
+                    LightKind::Directional { direction } => -*direction,
+                    LightKind::Point { position } | LightKind::Spot { position, .. } => {
+                        *position - point
                     }
                 };
-                let normal = scene.face_normals[id as usize];
-                let lambert = normal.dot(to_light).abs();
-                let material =
-                    &scene.scene.materials[scene.scene.mesh.material_ids[id as usize] as usize];
-                let base = Vec3::new(
-                    material.base_color[0],
-                    material.base_color[1],
-                    material.base_color[2],
-                );
-                let emissive = Vec3::from(material.emissive);
-                let linear = base * light_color * (AMBIENT + (1.0 - AMBIENT) * lambert) + emissive;
-                *out = [
-                    encode_srgb(linear.x),
-                    encode_srgb(linear.y),
-                    encode_srgb(linear.z),
-                    255,
-                ];
+                (to.normalize_or_zero(), Vec3::from(l.color).min(Vec3::ONE))
             }
-        });
+        };
+        let normal = self.scene.face_normals[id as usize];
+        let lambert = normal.dot(to_light).abs();
+        let scene = &self.scene.scene;
+        let material = &scene.materials[scene.mesh.material_ids[id as usize] as usize];
+        let base = Vec3::new(
+            material.base_color[0],
+            material.base_color[1],
+            material.base_color[2],
+        );
+        let emissive = Vec3::from(material.emissive);
+        base * light_color * (AMBIENT + (1.0 - AMBIENT) * lambert) + emissive
+    }
 }
 
 /// Linear [0, 1] → sRGB byte.
@@ -86,4 +76,38 @@ pub fn encode_srgb(v: f32) -> u8 {
         1.055 * v.powf(1.0 / 2.4) - 0.055
     };
     (s * 255.0 + 0.5) as u8
+}
+
+/// sRGB byte → linear [0, 1].
+#[inline]
+pub fn decode_srgb(b: u8) -> f32 {
+    let s = f32::from(b) / 255.0;
+    if s <= 0.040_45 {
+        s / 12.92
+    } else {
+        ((s + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// An sRGB colour in linear light.
+pub fn linear_rgb(c: [u8; 4]) -> Vec3 {
+    Vec3::new(decode_srgb(c[0]), decode_srgb(c[1]), decode_srgb(c[2]))
+}
+
+/// Linear RGB → opaque sRGB RGBA8.
+#[inline]
+pub fn encode_rgb(c: Vec3) -> [u8; 4] {
+    [encode_srgb(c.x), encode_srgb(c.y), encode_srgb(c.z), 255]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_srgb_byte_survives_decoding_and_encoding() {
+        for b in 0..=255u8 {
+            assert_eq!(encode_srgb(decode_srgb(b)), b);
+        }
+    }
 }

@@ -14,18 +14,27 @@ pub struct StageTimes {
     pub traversal: f64,
     /// Per-sample coverage and depth tests over bounding boxes.
     pub coverage: f64,
-    /// Shading of visible samples.
+    /// Shading of visible samples and the resolve into pixels.
     pub shading: f64,
     pub total: f64,
 }
 
-/// How many pixels got zero, one, or more coverage writes. On a closed mesh seen
-/// from inside (or a plane filling the screen) every pixel must be in `one`.
+/// How many stored samples got zero, one, or more coverage writes. On a closed
+/// mesh seen from inside (or a plane filling the screen) every sample must be in
+/// `one`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 pub struct CoverageHistogram {
     pub zero: u64,
     pub one: u64,
     pub many: u64,
+}
+
+impl std::ops::AddAssign for CoverageHistogram {
+    fn add_assign(&mut self, o: CoverageHistogram) {
+        self.zero += o.zero;
+        self.one += o.one;
+        self.many += o.many;
+    }
 }
 
 impl CoverageHistogram {
@@ -54,6 +63,15 @@ pub struct Stats {
     pub edge_evaluations: u64,
     /// BVH nodes whose children were tested against a ray.
     pub bvh_nodes_visited: u64,
+    /// Coverage positions per pixel (`C` of the anti-aliasing mode; 1 without).
+    pub samples_per_pixel: u32,
+    /// Positions per pixel that keep depth and triangle id (`S`).
+    pub stored_samples_per_pixel: u32,
+    /// Coverage samples of the image: pixels × `samples_per_pixel`.
+    pub coverage_samples: u64,
+    /// Shading evaluations (SSAA: one per covered sample; MSAA and CSAA: one per
+    /// pixel per triangle it shows).
+    pub shading_samples: u64,
     pub coverage_histogram: CoverageHistogram,
     /// Largest per-pixel edge-evaluation count (the top of the heat map's scale).
     pub max_edge_evals_per_pixel: u32,
@@ -71,6 +89,9 @@ pub struct Stats {
 pub struct Hashes {
     pub triangle_id: String,
     pub color: String,
+    /// Every sample's triangle id (with anti-aliasing, the per-pixel sample
+    /// digests; without, the same as `triangle_id`).
+    pub samples: String,
 }
 
 impl Hashes {
@@ -81,9 +102,18 @@ impl Hashes {
             .flat_map(|v| v.to_le_bytes())
             .collect();
         let color: Vec<u8> = fb.color.iter().flatten().copied().collect();
+        let hex = |bytes: &[u8]| format!("{:016x}", xxhash_rust::xxh3::xxh3_64(bytes));
+        let triangle_id = hex(&ids);
+        let samples = if fb.sample_digest.is_empty() {
+            triangle_id.clone()
+        } else {
+            let digests: Vec<u8> = fb.sample_digest.iter().flat_map(|v| v.to_le_bytes()).collect();
+            hex(&digests)
+        };
         Hashes {
-            triangle_id: format!("{:016x}", xxhash_rust::xxh3::xxh3_64(&ids)),
-            color: format!("{:016x}", xxhash_rust::xxh3::xxh3_64(&color)),
+            triangle_id,
+            color: hex(&color),
+            samples,
         }
     }
 }

@@ -40,11 +40,11 @@ pub struct TraversalOracles {
 }
 
 /// Per-frustum traversal state and counters.
-pub(crate) struct Traversal<'a> {
+pub(crate) struct Traversal<'a, 't> {
     pub scene: &'a PreparedScene,
     pub view: &'a View,
     pub oracles: TraversalOracles,
-    pub tile: TileBuffer,
+    pub tile: &'t mut TileBuffer<'a>,
     pub counters: RasterCounters,
     pub nodes_visited: u64,
     pub setups: u64,
@@ -65,18 +65,19 @@ struct NodeBox {
     min_w: f32,
 }
 
-impl<'a> Traversal<'a> {
+impl<'a, 't> Traversal<'a, 't> {
+    /// A traversal of the frustum over `tile`'s pixels.
     pub fn new(
         scene: &'a PreparedScene,
         view: &'a View,
         oracles: TraversalOracles,
-        rect: (u32, u32, u32, u32),
+        tile: &'t mut TileBuffer<'a>,
     ) -> Self {
         Traversal {
             scene,
             view,
             oracles,
-            tile: TileBuffer::new(rect.0, rect.1, rect.2, rect.3),
+            tile,
             counters: RasterCounters::default(),
             nodes_visited: 0,
             setups: 0,
@@ -268,7 +269,7 @@ impl<'a> Traversal<'a> {
             let k = scene.bvh.cwbvh.primitive_indices[slot as usize];
             let id = scene.drawable[k as usize];
             let p = &scene.triangles[id as usize];
-            let Some(rect) = screen_rect(p, self.view) else {
+            let Some(rect) = screen_rect(p, self.view, self.tile.pattern.span) else {
                 continue;
             };
             let Some(clip) = rect.intersect(f) else {
@@ -279,7 +280,7 @@ impl<'a> Traversal<'a> {
                 continue;
             };
             raster_triangle(
-                &mut self.tile,
+                self.tile,
                 &tri,
                 id,
                 clip,

@@ -29,7 +29,7 @@ pub struct RenderArgs {
     /// (default: the camera's own; bare words keep its field of view or height).
     #[arg(long)]
     viewport: Option<String>,
-    /// Anti-aliasing mode (only `none` so far).
+    /// Anti-aliasing mode: none, ssaa:N (4|16|64|256), msaa:N (2|4|8|16), csaa:CxS (e.g. 16x4).
     #[arg(long, default_value = "none")]
     aa: String,
     /// Image size, WIDTHxHEIGHT.
@@ -50,7 +50,7 @@ pub struct RenderArgs {
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
-    parse_aa(&args.aa).map_err(|e| CliError::Usage(format!("--{e}")))?;
+    let aa = parse_aa(&args.aa).map_err(|e| CliError::Usage(format!("--{e}")))?;
     let scene =
         continuum::scene::load_named_or_path(&args.scene, &scenes_dir(args.scenes.as_ref()))
             .map_err(|e| CliError::Usage(format!("--scene: {e}")))?;
@@ -75,6 +75,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         camera,
         width,
         height,
+        aa,
     };
     let out = render(&prepared, &request).map_err(|e| CliError::Usage(format!("--{e}")))?;
 

@@ -270,6 +270,7 @@ fn measure_algorithm(
         camera: camera.clone(),
         width: args.size.0,
         height: args.size.1,
+        aa: continuum::AaMode::None,
     };
     let mut out = pool
         .install(|| render(prepared, &request))

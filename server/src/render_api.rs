@@ -11,7 +11,7 @@ use base64::Engine;
 use continuum::request::{
     CameraSpec, FieldError, parse_aa, parse_algorithm, parse_size, parse_viewport,
 };
-use continuum::{AlgorithmId, RenderOutput, RenderRequest, Viewport, maps};
+use continuum::{AaMode, AlgorithmId, RenderOutput, RenderRequest, Viewport, maps};
 use serde::Deserialize;
 use serde_json::{Value, json};
 
@@ -43,6 +43,7 @@ struct Checked {
     camera: Option<CameraSpec>,
     viewport: Option<String>,
     size: (u32, u32),
+    aa: AaMode,
 }
 
 fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
@@ -77,9 +78,8 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
             return Err(viewport.unsupported(algorithm).into());
         }
     }
-    body.aa.as_deref().map(parse_aa).transpose()?;
-    // Every mode that exists so far takes one sample per pixel.
-    let samples_per_pixel = 1;
+    let aa = body.aa.as_deref().map(parse_aa).transpose()?.unwrap_or_default();
+    let samples_per_pixel = aa.coverage_samples();
     if samples_per_pixel > state.limits.max_samples_per_pixel {
         return Err(FieldError::new(
             "aa",
@@ -114,6 +114,7 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
         camera: body.camera.clone(),
         viewport: body.viewport.clone(),
         size,
+        aa,
     })
 }
 
@@ -145,6 +146,7 @@ async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, 
             camera,
             width: c.size.0,
             height: c.size.1,
+            aa: c.aa,
         };
         let out = continuum::render(&prepared, &request)
             .map_err(|e| ApiError::bad_request(e.field, e.to_string()))?;
@@ -307,7 +309,7 @@ pub async fn algorithms() -> Json<Value> {
                     .map(Viewport::kind)
                     .collect::<Vec<_>>(),
                 "takes_oracles": a.pipeline() != continuum::Pipeline::Rays,
-                "aa": ["none"],
+                "aa": AaMode::all().iter().map(ToString::to_string).collect::<Vec<_>>(),
             })
         })
         .collect();

@@ -62,6 +62,7 @@ pub fn render_with_oracles(
             camera: camera.clone(),
             width,
             height,
+            aa: continuum::AaMode::None,
         },
     )
     .unwrap_or_else(|e| panic!("{algorithm} {oracles:?}: {e}"))

@@ -26,12 +26,15 @@ use serde::{Serialize, Serializer};
 
 pub use crate::binning::SampleOracles;
 
+use crate::aa::{SamplePattern, SampleSpan};
+use crate::aa::resolve::resolve_tile;
 use crate::camera::{View, Viewport};
 use crate::edge::{CurvedTriangle, Triangle3D};
-use crate::framebuffer::Framebuffer;
+use crate::framebuffer::{Framebuffer, ResolvedTile, TileBuffer};
 use crate::prepared::PreparedScene;
 use crate::request::FieldError;
-use crate::stats::{RasterCounters, Stats};
+use crate::shade::Shader;
+use crate::stats::{CoverageHistogram, RasterCounters, Stats};
 use crate::traversal::{Traversal, TraversalOracles};
 use tiles::rasterize_tiled;
 
@@ -297,83 +300,197 @@ impl Pipeline {
     }
 }
 
-/// Runs `pipeline`, filling visibility buffers and counters. The viewport must
-/// be one the pipeline [serves](Pipeline::serves).
+
+/// Renders `view` of `scene` with `pipeline` into `fb`: the pixels, counters
+/// and stage times. The viewport must be one the pipeline
+/// [serves](Pipeline::serves).
 pub(crate) fn run(
     pipeline: Pipeline,
     scene: &PreparedScene,
     view: &View,
+    pattern: &SamplePattern,
     fb: &mut Framebuffer,
     stats: &mut Stats,
 ) {
-    match pipeline {
+    let context = TileContext {
+        view,
+        pattern,
+        shader: Shader::new(scene),
+    };
+    let pass = match pipeline {
         Pipeline::AllTriangles { edges, samples } => {
             let start = Instant::now();
-            let counters = match edges {
-                EdgeKind::TwoD => {
-                    timed_tiles(&setup2d::setup_2d(scene, view), fb, samples, stats, start)
-                }
-                EdgeKind::Homogeneous => timed_tiles(
-                    &setup3d::setup_homogeneous(scene, view),
+            let span = pattern.span;
+            match edges {
+                EdgeKind::TwoD => timed_tiles(
+                    &setup2d::setup_2d(scene, view, span),
                     fb,
                     samples,
+                    &context,
+                    stats,
+                    start,
+                ),
+                EdgeKind::Homogeneous => timed_tiles(
+                    &setup3d::setup_homogeneous(scene, view, span),
+                    fb,
+                    samples,
+                    &context,
                     stats,
                     start,
                 ),
                 EdgeKind::ThreeD if view.sphere.is_some() => {
-                    let mut items = setup3d::setup_curved(scene, view);
+                    let mut items = setup3d::setup_curved(scene, view, span);
                     if samples.incremental {
                         items.iter_mut().for_each(|p| p.tri.incremental = true);
                     }
-                    timed_tiles(&items, fb, samples, stats, start)
+                    timed_tiles(&items, fb, samples, &context, stats, start)
                 }
-                EdgeKind::ThreeD => {
-                    timed_tiles(&setup3d::setup_3d(scene, view), fb, samples, stats, start)
-                }
-            };
-            stats.counters = counters;
+                EdgeKind::ThreeD => timed_tiles(
+                    &setup3d::setup_3d(scene, view, span),
+                    fb,
+                    samples,
+                    &context,
+                    stats,
+                    start,
+                ),
+            }
         }
         Pipeline::Frusta(oracles) => {
             let start = Instant::now();
-            let done: Vec<Traversal> = fb
+            let done: Vec<_> = fb
                 .tile_rects(oracles.frustum)
                 .into_par_iter()
-                .map(|rect| {
-                    let mut t = Traversal::new(scene, view, oracles, rect);
-                    t.run();
-                    t
+                .map(|(x0, y0, x1, y1)| {
+                    let tile = TileBuffer::new(x0, y0, x1, y1, pattern);
+                    context.run_tile(tile, |tile| {
+                        let mut t = Traversal::new(scene, view, oracles, tile);
+                        t.run();
+                        (t.counters, t.nodes_visited, t.setups)
+                    })
                 })
                 .collect();
-            let mut counters = RasterCounters::default();
-            for t in &done {
-                fb.store(&t.tile);
-                counters += t.counters;
-                stats.bvh_nodes_visited += t.nodes_visited;
-                stats.triangle_setups += t.setups;
+            let mut pass = Pass::default();
+            for finished in done {
+                let (counters, nodes, setups) = finished.result;
+                pass.store(fb, finished.map(|_| counters));
+                stats.bvh_nodes_visited += nodes;
+                stats.triangle_setups += setups;
             }
-            stats.counters = counters;
-            stats.time_ms.traversal = start.elapsed().as_secs_f64() * 1e3;
+            let (traversal, shading) = pass.split(start.elapsed().as_secs_f64() * 1e3);
+            stats.time_ms.traversal = traversal;
+            stats.time_ms.shading = shading;
+            pass
         }
         Pipeline::Rays if view.sphere.is_some() => {
-            raycast::render_raycast(scene, view, fb, stats, CurvedTriangle::setup);
+            raycast::render_raycast(scene, &context, fb, stats, CurvedTriangle::setup)
         }
-        Pipeline::Rays => raycast::render_raycast(scene, view, fb, stats, Triangle3D::setup),
-    }
+        Pipeline::Rays => raycast::render_raycast(scene, &context, fb, stats, Triangle3D::setup),
+    };
+    stats.counters = pass.counters;
+    stats.coverage_histogram = pass.histogram;
+    stats.shading_samples = pass.shading_samples;
 }
 
 fn timed_tiles<T: crate::edge::Coverage + Sync>(
     items: &[tiles::Placed<T>],
     fb: &mut Framebuffer,
     samples: SampleOracles,
+    context: &TileContext,
     stats: &mut Stats,
     start: Instant,
-) -> RasterCounters {
+) -> Pass {
     stats.triangle_setups = items.len() as u64;
     stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
     let start = Instant::now();
-    let counters = rasterize_tiled(items, fb, samples);
-    stats.time_ms.coverage = start.elapsed().as_secs_f64() * 1e3;
-    counters
+    let pass = rasterize_tiled(items, fb, samples, context);
+    let (coverage, shading) = pass.split(start.elapsed().as_secs_f64() * 1e3);
+    stats.time_ms.coverage = coverage;
+    stats.time_ms.shading = shading;
+    pass
+}
+
+/// What every tile worker needs besides its own work: where samples lie and
+/// how to shade them.
+#[derive(Debug)]
+pub(crate) struct TileContext<'a> {
+    pub view: &'a View,
+    pub pattern: &'a SamplePattern,
+    pub shader: Shader<'a>,
+}
+
+/// A tile rendered and resolved by one worker, with what its rendering returned.
+#[derive(Debug)]
+pub(crate) struct Finished<R> {
+    pub resolved: ResolvedTile,
+    pub result: R,
+    /// Worker seconds spent rendering and resolving.
+    pub render_s: f64,
+    pub resolve_s: f64,
+}
+
+impl<R> Finished<R> {
+    fn map<S>(self, f: impl FnOnce(R) -> S) -> Finished<S> {
+        Finished {
+            resolved: self.resolved,
+            result: f(self.result),
+            render_s: self.render_s,
+            resolve_s: self.resolve_s,
+        }
+    }
+}
+
+impl<'a> TileContext<'a> {
+    /// Renders `tile` with `render`, then resolves its samples into pixels.
+    pub fn run_tile<R>(
+        &self,
+        mut tile: TileBuffer<'a>,
+        render: impl FnOnce(&mut TileBuffer<'a>) -> R,
+    ) -> Finished<R> {
+        let start = Instant::now();
+        let result = render(&mut tile);
+        let render_s = start.elapsed().as_secs_f64();
+        let start = Instant::now();
+        let resolved = resolve_tile(&tile, self.view, &self.shader);
+        Finished {
+            resolved,
+            result,
+            render_s,
+            resolve_s: start.elapsed().as_secs_f64(),
+        }
+    }
+}
+
+/// The totals of one parallel pass over tiles.
+#[derive(Debug, Default)]
+pub(crate) struct Pass {
+    pub counters: RasterCounters,
+    pub histogram: CoverageHistogram,
+    pub shading_samples: u64,
+    render_s: f64,
+    resolve_s: f64,
+}
+
+impl Pass {
+    /// Stores a finished tile's pixels and adds up its counters.
+    pub fn store(&mut self, fb: &mut Framebuffer, finished: Finished<RasterCounters>) {
+        fb.store(&finished.resolved);
+        self.counters += finished.result;
+        self.histogram += finished.resolved.histogram;
+        self.shading_samples += finished.resolved.shading_samples;
+        self.render_s += finished.render_s;
+        self.resolve_s += finished.resolve_s;
+    }
+
+    /// The pass's wall time split into rendering and shading (with the resolve)
+    /// in proportion to the worker time each took: workers do both, tile by tile.
+    pub fn split(&self, wall_ms: f64) -> (f64, f64) {
+        let busy = self.render_s + self.resolve_s;
+        if busy <= 0.0 {
+            return (wall_ms, 0.0);
+        }
+        let shading = wall_ms * self.resolve_s / busy;
+        (wall_ms - shading, shading)
+    }
 }
 
 impl fmt::Display for AlgorithmId {
@@ -430,8 +547,9 @@ impl PixelRect {
         (r.x0 <= r.x1 && r.y0 <= r.y1).then_some(r)
     }
 
-    /// The pixels whose centres lie in `[min_x, max_x] × [min_y, max_y]`, clamped
-    /// to a `width × height` image; `None` when there are none.
+    /// The pixels with a sample in `[min_x, max_x] × [min_y, max_y]` (sample
+    /// offsets within `span` of the pixel corner), clamped to a `width × height`
+    /// image; `None` when there are none.
     pub fn from_bounds(
         min_x: f32,
         min_y: f32,
@@ -439,11 +557,14 @@ impl PixelRect {
         max_y: f32,
         width: u32,
         height: u32,
+        span: SampleSpan,
     ) -> Option<PixelRect> {
-        // Pixel p's centre is p + 0.5: first p with p + 0.5 ≥ min, last with p + 0.5 ≤ max.
-        let lo = |v: f32| (v - 0.5).ceil().max(0.0);
-        let hi = |v: f32, n: u32| (v - 0.5).floor().min(n as f32 - 1.0);
-        let (x0, y0, x1, y1) = (lo(min_x), lo(min_y), hi(max_x, width), hi(max_y, height));
+        // Pixel p's samples lie in [p + lo, p + hi]: first p with p + hi ≥ min,
+        // last with p + lo ≤ max.
+        let first = |v: f32, hi: f32| (v - hi).ceil().max(0.0);
+        let last = |v: f32, lo: f32, n: u32| (v - lo).floor().min(n as f32 - 1.0);
+        let (x0, y0) = (first(min_x, span.hi[0]), first(min_y, span.hi[1]));
+        let (x1, y1) = (last(max_x, span.lo[0], width), last(max_y, span.lo[1], height));
         // Also rejects NaN bounds.
         if !(x0 <= x1 && y0 <= y1) {
             return None;

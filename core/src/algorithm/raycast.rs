@@ -1,4 +1,4 @@
-//! `raycast`: the ray-casting end of the continuum. One ray per pixel walks the
+//! `raycast`: the ray-casting end of the continuum. One ray per sample walks the
 //! CWBVH front to back; each leaf triangle is tested with the *same* 3D edge
 //! function coefficients and the same [`Triangle3D::sample`] as `3dr-brute`, so
 //! the two agree bit for bit (obvhs's own triangle test is not watertight and is
@@ -10,9 +10,10 @@ use rayon::prelude::*;
 
 use glam::Vec3;
 
-use crate::camera::{View, pixel_center};
+use super::{Pass, TileContext};
+use crate::camera::View;
 use crate::edge::Coverage;
-use crate::framebuffer::{BACKGROUND, Framebuffer, wins_depth_test};
+use crate::framebuffer::{BACKGROUND, Framebuffer, TileBuffer, wins_depth_test};
 use crate::prepared::PreparedScene;
 use crate::stats::Stats;
 
@@ -24,15 +25,18 @@ const CULL_MARGIN: f32 = 1.0 + 1.0 / 1024.0;
 
 const BAND_ROWS: u32 = 4;
 
-/// Casts one ray per pixel; `setup` gives the same triangles the 3D rasterizers
-/// of this viewport use.
+/// Casts one ray per stored sample; `setup` gives the same triangles the 3D
+/// rasterizers of this viewport use. Under CSAA the coverage-only positions are
+/// decided as the rasterizers decide them: each triangle a stored ray found is
+/// tested at every coverage position of the pixel.
 pub(crate) fn render_raycast<T: Coverage + Send + Sync>(
     scene: &PreparedScene,
-    view: &View,
+    context: &TileContext,
     fb: &mut Framebuffer,
     stats: &mut Stats,
     setup: impl Fn(&[Vec3; 3], &View) -> Option<T> + Sync,
-) {
+) -> Pass {
+    let (view, pattern) = (context.view, context.pattern);
     // 1. Setup: the 3D edge functions of every drawable triangle for this view.
     let start = Instant::now();
     let setups: Vec<Option<T>> = scene
@@ -43,47 +47,102 @@ pub(crate) fn render_raycast<T: Coverage + Send + Sync>(
     stats.triangle_setups = setups.iter().filter(|s| s.is_some()).count() as u64;
     stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
 
-    // 2. One ray per pixel, bands of rows in parallel.
+    // 2. Rays per sample, bands of rows in parallel, each resolved by its worker.
     let start = Instant::now();
-    let nodes: u64 = fb
-        .bands_mut(BAND_ROWS)
+    let bands: Vec<(u32, u32)> = (0..fb.height)
+        .step_by(BAND_ROWS as usize)
+        .map(|y0| (y0, (y0 + BAND_ROWS).min(fb.height)))
+        .collect();
+    let width = fb.width;
+    let done: Vec<_> = bands
         .into_par_iter()
-        .map(|band| {
-            let mut nodes = 0;
-            for y in band.y0..band.y1 {
-                let yc = pixel_center(y);
-                for x in 0..band.width {
-                    let xc = pixel_center(x);
-                    let (mut best_w, mut best_id) = (f32::INFINITY, BACKGROUND);
-                    let (mut evals, mut covered) = (0u32, 0u32);
-                    // No ray outside the viewport (the parabolic disc): background.
-                    let Some((origin, direction)) = view.ray(xc, yc) else {
-                        continue;
-                    };
-                    nodes += scene.bvh.walk(origin, direction, |k| {
-                        if let Some(tri) = &setups[k as usize] {
-                            evals += 1;
-                            if let Some(w) = tri.sample(xc, yc) {
-                                covered += 1;
-                                let id = scene.slot_triangles[k as usize];
-                                if wins_depth_test(w, id, best_w, best_id) {
-                                    best_w = w;
-                                    best_id = id;
-                                }
+        .map(|(y0, y1)| {
+            let tile = TileBuffer::new(0, y0, width, y1, pattern);
+            context.run_tile(tile, |tile| cast_band(scene, view, &setups, tile))
+        })
+        .collect();
+    let mut pass = Pass::default();
+    for finished in done {
+        stats.bvh_nodes_visited += finished.result;
+        pass.store(fb, finished.map(|_| Default::default()));
+    }
+    let (traversal, shading) = pass.split(start.elapsed().as_secs_f64() * 1e3);
+    stats.time_ms.traversal = traversal;
+    stats.time_ms.shading = shading;
+    pass
+}
+
+/// Every stored sample of the band's pixels; returns the BVH nodes visited.
+fn cast_band<T: Coverage>(
+    scene: &PreparedScene,
+    view: &View,
+    setups: &[Option<T>],
+    tile: &mut TileBuffer,
+) -> u64 {
+    let pattern = tile.pattern;
+    let (stored, pixels) = (pattern.stored, tile.pixels);
+    let mut nodes = 0;
+    let mut slots = [0u32; 8];
+    for y in tile.y0..tile.y1 {
+        for x in tile.x0..tile.x1 {
+            let i = tile.index(x, y);
+            for (s, &[ox, oy]) in pattern.positions[..stored].iter().enumerate() {
+                let (xs, ys) = (x as f32 + ox, y as f32 + oy);
+                // No ray outside the viewport (the parabolic disc): background.
+                let Some((origin, direction)) = view.ray(xs, ys) else {
+                    continue;
+                };
+                let (mut best_w, mut best_id, mut best_slot) = (f32::INFINITY, BACKGROUND, 0);
+                let (mut evals, mut covered) = (0u32, 0u32);
+                nodes += scene.bvh.walk(origin, direction, |k| {
+                    if let Some(tri) = &setups[k as usize] {
+                        evals += 1;
+                        if let Some(w) = tri.sample(xs, ys) {
+                            covered += 1;
+                            let id = scene.slot_triangles[k as usize];
+                            if wins_depth_test(w, id, best_w, best_id) {
+                                (best_w, best_id, best_slot) = (w, id, k);
                             }
                         }
-                        best_w * CULL_MARGIN
-                    });
-                    let i = band.index(x, y);
-                    band.edge_evals[i] = evals;
-                    band.coverage_writes[i] = covered;
-                    band.depth[i] = best_w;
-                    band.triangle_id[i] = best_id;
+                    }
+                    best_w * CULL_MARGIN
+                });
+                tile.edge_evals[i] += evals;
+                let j = s * pixels + i;
+                tile.coverage_writes[j] = covered;
+                tile.depth[j] = best_w;
+                tile.triangle_id[j] = best_id;
+                if pattern.has_coverage_only() {
+                    slots[s] = best_slot;
                 }
             }
-            nodes
-        })
-        .sum();
-    stats.bvh_nodes_visited = nodes;
-    stats.time_ms.traversal = start.elapsed().as_secs_f64() * 1e3;
+            if pattern.has_coverage_only() {
+                // The coverage mask of each stored triangle over the pixel.
+                for s in 0..stored {
+                    let j = s * pixels + i;
+                    if tile.triangle_id[j] == BACKGROUND {
+                        continue;
+                    }
+                    let same = (0..s).find(|&t| tile.triangle_id[t * pixels + i] == tile.triangle_id[j]);
+                    tile.masks[j] = match same {
+                        Some(t) => tile.masks[t * pixels + i],
+                        None => {
+                            let Some(tri) = &setups[slots[s] as usize] else {
+                                continue;
+                            };
+                            tile.edge_evals[i] += pattern.coverage() as u32;
+                            let mut mask = 0;
+                            for (c, &[ox, oy]) in pattern.positions.iter().enumerate() {
+                                if tri.sample(x as f32 + ox, y as f32 + oy).is_some() {
+                                    mask |= 1 << c;
+                                }
+                            }
+                            mask
+                        }
+                    };
+                }
+            }
+        }
+    }
+    nodes
 }

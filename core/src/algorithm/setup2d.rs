@@ -6,6 +6,7 @@ use rayon::prelude::*;
 
 use super::PixelRect;
 use super::tiles::Placed;
+use crate::aa::SampleSpan;
 use crate::camera::View;
 use crate::clip::{clip_triangle, pipeline_planes};
 use crate::edge::{ScreenVertex, Triangle2D};
@@ -13,7 +14,11 @@ use crate::prepared::PreparedScene;
 
 /// Every drawable triangle, clipped, projected and set up; pieces without
 /// samples on screen are dropped.
-pub(crate) fn setup_2d(scene: &PreparedScene, view: &View) -> Vec<Placed<Triangle2D>> {
+pub(crate) fn setup_2d(
+    scene: &PreparedScene,
+    view: &View,
+    span: SampleSpan,
+) -> Vec<Placed<Triangle2D>> {
     let planes = pipeline_planes(view);
     let affine = view.is_orthographic();
     scene
@@ -55,7 +60,7 @@ pub(crate) fn setup_2d(scene: &PreparedScene, view: &View) -> Vec<Placed<Triangl
                     continue;
                 };
                 let [x0, y0, x1, y1] = tri.bounds;
-                if let Some(rect) = PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height)
+                if let Some(rect) = PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height, span)
                 {
                     out.push(Placed { tri, rect, id });
                 }

@@ -7,31 +7,45 @@ use rayon::prelude::*;
 
 use super::PixelRect;
 use super::tiles::Placed;
+use crate::aa::SampleSpan;
 use crate::camera::View;
 use crate::clip::{ClipPlane, clip_triangle};
 use crate::edge::{self, CurvedTriangle, Triangle3D};
 use crate::prepared::PreparedScene;
 
 /// Every drawable triangle with samples on screen, set up with 3D edge functions.
-pub(crate) fn setup_3d(scene: &PreparedScene, view: &View) -> Vec<Placed<Triangle3D>> {
-    setup_visible(scene, view, Triangle3D::setup)
+pub(crate) fn setup_3d(
+    scene: &PreparedScene,
+    view: &View,
+    span: SampleSpan,
+) -> Vec<Placed<Triangle3D>> {
+    setup_visible(scene, view, span, Triangle3D::setup)
 }
 
 /// Every drawable triangle with samples on a non-planar viewport, set up with 3D
 /// edge functions evaluated per sample direction (paper §3.5).
-pub(crate) fn setup_curved(scene: &PreparedScene, view: &View) -> Vec<Placed<CurvedTriangle>> {
-    setup_visible(scene, view, CurvedTriangle::setup)
+pub(crate) fn setup_curved(
+    scene: &PreparedScene,
+    view: &View,
+    span: SampleSpan,
+) -> Vec<Placed<CurvedTriangle>> {
+    setup_visible(scene, view, span, CurvedTriangle::setup)
 }
 
 /// Every drawable triangle with samples on screen, set up for homogeneous 2D
 /// rasterization (no clipping).
-pub(crate) fn setup_homogeneous(scene: &PreparedScene, view: &View) -> Vec<Placed<Triangle3D>> {
-    setup_visible(scene, view, edge::setup_homogeneous)
+pub(crate) fn setup_homogeneous(
+    scene: &PreparedScene,
+    view: &View,
+    span: SampleSpan,
+) -> Vec<Placed<Triangle3D>> {
+    setup_visible(scene, view, span, edge::setup_homogeneous)
 }
 
 fn setup_visible<T: Send>(
     scene: &PreparedScene,
     view: &View,
+    span: SampleSpan,
     setup: impl Fn(&[Vec3; 3], &View) -> Option<T> + Sync,
 ) -> Vec<Placed<T>> {
     scene
@@ -39,7 +53,7 @@ fn setup_visible<T: Send>(
         .par_iter()
         .filter_map(|&id| {
             let p = &scene.triangles[id as usize];
-            let rect = screen_rect(p, view)?;
+            let rect = screen_rect(p, view, span)?;
             Some(Placed {
                 tri: setup(p, view)?,
                 rect,
@@ -54,8 +68,9 @@ fn setup_visible<T: Send>(
 /// nearer) projected, padded by 1/16 pixel plus a relative 2⁻¹⁶ so that rounding
 /// in the projection never cuts off a sample the 3D edge functions cover.
 /// Non-planar viewports: the bounds of the triangle's cap of directions
-/// ([`crate::camera::SphereMap::bounds_of`]), padded by a pixel.
-pub(crate) fn screen_rect(p: &[Vec3; 3], view: &View) -> Option<PixelRect> {
+/// ([`crate::camera::SphereMap::bounds_of`]), padded by a pixel. The pixels
+/// returned are those with a sample (at offsets `span`) in the box.
+pub(crate) fn screen_rect(p: &[Vec3; 3], view: &View, span: SampleSpan) -> Option<PixelRect> {
     if let Some(map) = &view.sphere {
         let [x0, y0, x1, y1] = map.bounds_of(&p.map(|v| view.to_camera_f64(v)));
         return PixelRect::from_bounds(
@@ -65,6 +80,7 @@ pub(crate) fn screen_rect(p: &[Vec3; 3], view: &View) -> Option<PixelRect> {
             (y1 + 1.0) as f32,
             view.width,
             view.height,
+            span,
         );
     }
     let near_bound = view.near * (1.0 - 1.0 / 1024.0);
@@ -103,5 +119,6 @@ pub(crate) fn screen_rect(p: &[Vec3; 3], view: &View) -> Option<PixelRect> {
         max[1] + pad,
         view.width,
         view.height,
+        span,
     )
 }

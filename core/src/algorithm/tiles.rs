@@ -1,10 +1,10 @@
 //! Screen tiles: triangles are sorted into square tiles of the image by their
 //! bounding boxes (a counting sort), and the tiles are rendered in parallel,
-//! each into its own [`TileBuffer`].
+//! each into its own [`TileBuffer`] and resolved there.
 
 use rayon::prelude::*;
 
-use super::PixelRect;
+use super::{PixelRect, Pass, TileContext};
 use crate::binning::{SampleOracles, raster_triangle};
 use crate::edge::Coverage;
 use crate::framebuffer::{Framebuffer, TileBuffer};
@@ -26,7 +26,8 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
     items: &[Placed<T>],
     fb: &mut Framebuffer,
     oracles: SampleOracles,
-) -> RasterCounters {
+    context: &TileContext,
+) -> Pass {
     let columns = fb.width.div_ceil(TILE) as usize;
     let rows = fb.height.div_ceil(TILE) as usize;
     let tile_count = columns * rows;
@@ -56,28 +57,29 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
         }
     }
 
-    // 2. Tiles in parallel, in input order within a tile.
+    // 2. Tiles in parallel, in input order within a tile, each resolved by
+    // its worker (the samples never outlive their tile).
     let rects = fb.tile_rects(TILE);
-    let done: Vec<(TileBuffer, RasterCounters)> = rects
+    let done: Vec<_> = rects
         .par_iter()
         .enumerate()
         .map(|(t, &(x0, y0, x1, y1))| {
-            let mut tile = TileBuffer::new(x0, y0, x1, y1);
-            let mut counters = RasterCounters::default();
-            for &k in &members[offsets[t] as usize..offsets[t + 1] as usize] {
-                let item = &items[k as usize];
-                // Non-empty: the item was sorted into this tile by its rect.
-                if let Some(clip) = item.rect.intersect(tile.rect()) {
-                    raster_triangle(&mut tile, &item.tri, item.id, clip, oracles, &mut counters);
+            context.run_tile(TileBuffer::new(x0, y0, x1, y1, context.pattern), |tile| {
+                let mut counters = RasterCounters::default();
+                for &k in &members[offsets[t] as usize..offsets[t + 1] as usize] {
+                    let item = &items[k as usize];
+                    // Non-empty: the item was sorted into this tile by its rect.
+                    if let Some(clip) = item.rect.intersect(tile.rect()) {
+                        raster_triangle(tile, &item.tri, item.id, clip, oracles, &mut counters);
+                    }
                 }
-            }
-            (tile, counters)
+                counters
+            })
         })
         .collect();
-    let mut total = RasterCounters::default();
-    for (tile, counters) in &done {
-        fb.store(tile);
-        total += *counters;
+    let mut pass = Pass::default();
+    for finished in done {
+        pass.store(fb, finished);
     }
-    total
+    pass
 }

@@ -193,6 +193,51 @@ impl LinearEdges for Triangle3D {
     }
 }
 
+/// The 8-lane forms of the scalar operations (no fused multiply-add, the same
+/// operation order, so every lane rounds as [`Coverage::sample`] does).
+impl Triangle3D {
+    #[inline(always)]
+    fn sample_lanes(&self, x: f32x8, y: f32x8) -> (u8, [f32; 8]) {
+        let zero = f32x8::ZERO;
+        let mut inside = f32x8::from([f32::from_bits(u32::MAX); 8]);
+        for k in 0..3 {
+            let e =
+                f32x8::splat(self.a[k]) + x * f32x8::splat(self.b[k]) + y * f32x8::splat(self.c[k]);
+            let on_edge = if self.owns[k] {
+                e.simd_eq(zero)
+            } else {
+                zero.simd_ne(zero)
+            };
+            inside &= e.simd_gt(zero) | on_edge;
+        }
+        let facing = self.facing_lanes(x, y);
+        inside &= facing.simd_gt(zero);
+        let mask = inside.to_bitmask() as u8;
+        if mask == 0 {
+            return (0, [0.0; 8]);
+        }
+        self.depth_lanes(x, y, facing, mask)
+    }
+
+    #[inline(always)]
+    fn facing_lanes(&self, x: f32x8, y: f32x8) -> f32x8 {
+        f32x8::splat(self.nd[0]) + x * f32x8::splat(self.nd[1]) + y * f32x8::splat(self.nd[2])
+    }
+
+    /// `w` per lane, and `mask` narrowed to the lanes at or beyond `near`.
+    #[inline(always)]
+    fn depth_lanes(&self, x: f32x8, y: f32x8, facing: f32x8, mask: u8) -> (u8, [f32; 8]) {
+        let volume = f32x8::splat(self.volume[0])
+            + x * f32x8::splat(self.volume[1])
+            + y * f32x8::splat(self.volume[2]);
+        let w = (volume / facing)
+            .fast_max(f32x8::splat(self.w_range[0]))
+            .fast_min(f32x8::splat(self.w_range[1]));
+        let mask = mask & w.simd_ge(f32x8::splat(self.near)).to_bitmask() as u8;
+        (mask, w.to_array())
+    }
+}
+
 impl Coverage for Triangle3D {
     #[inline(always)]
     fn sample(&self, x: f32, y: f32) -> Option<f32> {
@@ -213,34 +258,19 @@ impl Coverage for Triangle3D {
     #[inline(always)]
     fn sample8(&self, x0: f32, y: f32) -> (u8, [f32; 8]) {
         let x = f32x8::splat(x0) + f32x8::from([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
-        let y = f32x8::splat(y);
-        let zero = f32x8::ZERO;
-        let mut inside = f32x8::from([f32::from_bits(u32::MAX); 8]);
-        for k in 0..3 {
-            let e =
-                f32x8::splat(self.a[k]) + x * f32x8::splat(self.b[k]) + y * f32x8::splat(self.c[k]);
-            let on_edge = if self.owns[k] {
-                e.simd_eq(zero)
-            } else {
-                zero.simd_ne(zero)
-            };
-            inside &= e.simd_gt(zero) | on_edge;
-        }
-        let facing =
-            f32x8::splat(self.nd[0]) + x * f32x8::splat(self.nd[1]) + y * f32x8::splat(self.nd[2]);
-        inside &= facing.simd_gt(zero);
-        let mask = inside.to_bitmask() as u8;
-        if mask == 0 {
-            return (0, [0.0; 8]);
-        }
-        let volume = f32x8::splat(self.volume[0])
-            + x * f32x8::splat(self.volume[1])
-            + y * f32x8::splat(self.volume[2]);
-        let w = (volume / facing)
-            .fast_max(f32x8::splat(self.w_range[0]))
-            .fast_min(f32x8::splat(self.w_range[1]));
-        let mask = mask & w.simd_ge(f32x8::splat(self.near)).to_bitmask() as u8;
-        (mask, w.to_array())
+        self.sample_lanes(x, f32x8::splat(y))
+    }
+
+    #[inline(always)]
+    fn sample_points8(&self, x: [f32; 8], y: [f32; 8]) -> (u8, [f32; 8]) {
+        self.sample_lanes(f32x8::from(x), f32x8::from(y))
+    }
+
+    #[inline(always)]
+    fn depth_inside8(&self, x: [f32; 8], y: [f32; 8]) -> (u8, [f32; 8]) {
+        let (x, y) = (f32x8::from(x), f32x8::from(y));
+        let facing = self.facing_lanes(x, y);
+        self.depth_lanes(x, y, facing, facing.simd_gt(f32x8::ZERO).to_bitmask() as u8)
     }
 
     fn min_depth(&self) -> f32 {

@@ -71,6 +71,36 @@ pub trait Coverage {
         (mask, depth)
     }
 
+    /// Coverage and depth of eight samples at any points `(x[k], y[k])` (the
+    /// samples of anti-aliasing patterns): the same decisions as
+    /// [`Coverage::sample`] per lane.
+    #[inline(always)]
+    fn sample_points8(&self, x: [f32; 8], y: [f32; 8]) -> (u8, [f32; 8]) {
+        let mut mask = 0;
+        let mut depth = [0.0; 8];
+        for (k, d) in depth.iter_mut().enumerate() {
+            if let Some(w) = self.sample(x[k], y[k]) {
+                mask |= 1 << k;
+                *d = w;
+            }
+        }
+        (mask, depth)
+    }
+
+    /// [`Coverage::depth_inside`] for eight points of a block found inside.
+    #[inline(always)]
+    fn depth_inside8(&self, x: [f32; 8], y: [f32; 8]) -> (u8, [f32; 8]) {
+        let mut mask = 0;
+        let mut depth = [0.0; 8];
+        for (k, d) in depth.iter_mut().enumerate() {
+            if let Some(w) = self.depth_inside(x[k], y[k]) {
+                mask |= 1 << k;
+                *d = w;
+            }
+        }
+        (mask, depth)
+    }
+
     /// Coverage of the `n` samples `(x0 + k, y)`, `k < n`: calls `hit(k, w)` for
     /// each covered one. The same decisions as [`Coverage::sample`] per sample.
     #[inline(always)]

@@ -84,6 +84,7 @@ fn bad_oracles_are_errors_naming_the_field() {
                 camera: camera.clone(),
                 width: 8,
                 height: 8,
+                aa: continuum::AaMode::None,
             },
         )
         .expect_err(text);

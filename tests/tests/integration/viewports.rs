@@ -177,6 +177,7 @@ fn incremental_evaluation_decides_like_direct_evaluation() {
             camera,
             width: 64,
             height: 32,
+            aa: continuum::AaMode::None,
         },
     )
     .unwrap_err();
@@ -241,6 +242,7 @@ fn unsupported_pairings_are_errors_listing_the_supported_ones() {
                     camera: camera.clone(),
                     width: 32,
                     height: 16,
+                    aa: continuum::AaMode::None,
                 },
             );
             let served = matches!(

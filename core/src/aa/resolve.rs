@@ -1,0 +1,170 @@
+//! The resolve: a tile's samples become pixels. Each coverage sample takes the
+//! colour of the surface it sees, and the pixel is their box-filtered mean in
+//! linear light.
+//!
+//! - Every position stored (none, SSAA, MSAA): coverage sample `s` sees the
+//!   triangle stored at `s`. SSAA shades each sample at its own position; MSAA
+//!   shades each distinct triangle of the pixel once, at the first sample that
+//!   holds it.
+//! - CSAA: a stored position as above. A coverage-only position sees, of the
+//!   triangles stored in the pixel whose coverage mask holds it, the nearest by
+//!   its stored depth (ties to the smaller id); if none covers it, the
+//!   background when a stored sample is background, else it is unknown and left
+//!   out of the mean (the information CSAA discards). This depends only on what
+//!   the stored samples hold, so it is the same in every algorithm.
+
+use glam::Vec3;
+
+use crate::camera::View;
+use crate::framebuffer::{BACKGROUND, ResolvedTile, TileBuffer, wins_depth_test};
+use crate::shade::{BACKGROUND_COLOR, OUTSIDE_VIEWPORT_COLOR, Shader, encode_rgb, linear_rgb};
+use crate::stats::CoverageHistogram;
+
+/// Most stored samples a pattern has (`ssaa:256`).
+const MAX_STORED: usize = 256;
+/// Most stored samples a CSAA pattern has.
+const MAX_CSAA_STORED: usize = 8;
+
+/// Start of a pixel's sample digest.
+const DIGEST_SEED: u64 = 0x9e37_79b9_7f4a_7c15;
+
+/// One step of the sample digest (a multiply–rotate hash; the digest only has
+/// to tell differing sample sets apart).
+#[inline(always)]
+fn mix(h: u64, v: u32) -> u64 {
+    (h ^ u64::from(v)).wrapping_mul(0x2127_599b_f432_5c37).rotate_left(29)
+}
+
+/// Resolves every pixel of `tile`.
+pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> ResolvedTile {
+    let pattern = tile.pattern;
+    let (stored, pixels) = (pattern.stored, tile.pixels);
+    debug_assert!(stored <= MAX_STORED);
+    let background = linear_rgb(BACKGROUND_COLOR);
+    let outside = linear_rgb(OUTSIDE_VIEWPORT_COLOR);
+    let mut out = ResolvedTile {
+        rect: [tile.x0, tile.y0, tile.x1, tile.y1],
+        color: vec![[0; 4]; pixels],
+        depth: tile.depth[..pixels].to_vec(),
+        triangle_id: tile.triangle_id[..pixels].to_vec(),
+        edge_evals: tile.edge_evals.clone(),
+        coverage_writes: vec![0; pixels],
+        sample_digest: Vec::new(),
+        histogram: CoverageHistogram::of(&tile.coverage_writes),
+        shading_samples: 0,
+    };
+    for (s, writes) in tile.coverage_writes.chunks_exact(pixels).enumerate() {
+        if s == 0 {
+            out.coverage_writes.copy_from_slice(writes);
+        } else {
+            for (sum, &w) in out.coverage_writes.iter_mut().zip(writes) {
+                *sum += w;
+            }
+        }
+    }
+    let anti_aliased = pattern.coverage() > 1;
+    if anti_aliased {
+        out.sample_digest = vec![0; pixels];
+    }
+    let mut slot_color = [Vec3::ZERO; MAX_STORED];
+    for y in tile.y0..tile.y1 {
+        for x in tile.x0..tile.x1 {
+            let i = tile.index(x, y);
+            let id_at = |s: usize| tile.triangle_id[s * pixels + i];
+            let depth_at = |s: usize| tile.depth[s * pixels + i];
+            // 1. The colour each stored sample sees (one shading when they all
+            // hold the same triangle and need not be shaded apart).
+            // (Background samples of a non-planar view may lie on both sides
+            // of the viewport's border, so they are not taken as one.)
+            let uniform = !pattern.shade_per_sample
+                && (id_at(0) != BACKGROUND || view.sphere.is_none())
+                && (1..stored).all(|s| id_at(s) == id_at(0));
+            for s in 0..if uniform { 1 } else { stored } {
+                let id = id_at(s);
+                if !pattern.shade_per_sample
+                    && id != BACKGROUND
+                    && let Some(t) = (0..s).find(|&t| id_at(t) == id)
+                {
+                    slot_color[s] = slot_color[t];
+                    continue;
+                }
+                let [ox, oy] = pattern.positions[s];
+                slot_color[s] = match view.ray(x as f32 + ox, y as f32 + oy) {
+                    None => outside,
+                    Some(_) if id == BACKGROUND => background,
+                    Some((origin, dir)) => {
+                        out.shading_samples += 1;
+                        shader.shade(id, origin, dir, depth_at(s))
+                    }
+                };
+            }
+            // 2. The box filter over the coverage samples.
+            if !anti_aliased {
+                // Exactly the stored colours, not a round trip through linear light.
+                out.color[i] = if id_at(0) != BACKGROUND {
+                    encode_rgb(slot_color[0])
+                } else if slot_color[0] == outside {
+                    OUTSIDE_VIEWPORT_COLOR
+                } else {
+                    BACKGROUND_COLOR
+                };
+                continue;
+            }
+            let mut sum: Vec3 = if uniform {
+                slot_color[0] * stored as f32
+            } else {
+                slot_color[..stored].iter().sum()
+            };
+            let mut known = stored as u32;
+            if pattern.has_coverage_only() {
+                // Each stored triangle's coverage over the pixel: the union of
+                // what each of its stored samples recorded.
+                let mut union = [0u32; MAX_CSAA_STORED];
+                for s in 0..stored {
+                    for t in 0..stored {
+                        if id_at(t) == id_at(s) {
+                            union[s] |= tile.masks[t * pixels + i];
+                        }
+                    }
+                }
+                for (c, &[ox, oy]) in pattern.positions.iter().enumerate().skip(stored) {
+                    let mut best: Option<usize> = None;
+                    for s in 0..stored {
+                        let id = id_at(s);
+                        if id != BACKGROUND
+                            && union[s] & (1 << c) != 0
+                            && best.is_none_or(|b| wins_depth_test(depth_at(s), id, depth_at(b), id_at(b)))
+                        {
+                            best = Some(s);
+                        }
+                    }
+                    let seen = match best {
+                        Some(s) => Some(slot_color[s]),
+                        None if view.sphere.is_some()
+                            && view.ray(x as f32 + ox, y as f32 + oy).is_none() =>
+                        {
+                            Some(outside)
+                        }
+                        None if (0..stored).any(|s| id_at(s) == BACKGROUND) => Some(background),
+                        None => None,
+                    };
+                    if let Some(color) = seen {
+                        sum += color;
+                        known += 1;
+                    }
+                }
+            }
+            out.color[i] = encode_rgb(sum / known as f32);
+            // 3. The digest of every sample's id (and mask).
+            let mut digest = DIGEST_SEED;
+            for s in 0..stored {
+                digest = mix(digest, id_at(s));
+                if pattern.has_coverage_only() {
+                    digest = mix(digest, tile.masks[s * pixels + i]);
+                }
+            }
+            out.sample_digest[i] = digest;
+        }
+    }
+    out
+}
