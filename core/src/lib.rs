@@ -23,6 +23,7 @@ pub mod clip;
 pub mod edge;
 pub mod framebuffer;
 pub mod maps;
+pub mod metrics;
 pub mod peer;
 pub mod prepared;
 pub mod render;

@@ -1,7 +1,10 @@
 //! `continuum compare`: the benchmark. Every algorithm and peer on every scene,
 //! in one process, timed as medians over repeats and reported as ratios to
 //! `2dr-brute` (the paper's Fig. 9 form), with the counters that explain them.
-//! Writes `results.json` and `results.csv` into `--out`.
+//! Writes `results.json` and `results.csv` into `--out`. With `--aa`, every
+//! mode is measured too: its time against `none`, its shading and coverage
+//! samples, and its error (PSNR, FLIP) against a `ssaa:256` reference, plotted
+//! as `aa_cost.svg`.
 
 use std::collections::HashMap;
 use std::io::Write;
@@ -10,11 +13,13 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use continuum::peer::{PeerId, run_peer};
+use continuum::metrics::{self, ImageError};
 use continuum::request::{parse_algorithm, parse_size};
-use continuum::{AlgorithmId, PreparedScene, RenderRequest, View, render};
+use continuum::{AaMode, AlgorithmId, Framebuffer, PreparedScene, RenderRequest, View, render};
 use serde::Serialize;
 use serde_json::{Value, json};
 
+use crate::plot::{AaPoint, aa_cost_svg};
 use crate::{CliError, scenes_dir};
 
 #[derive(Args, Debug)]
@@ -38,6 +43,11 @@ pub struct CompareArgs {
     /// Worker threads [default: all cores].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     threads: Option<u32>,
+    /// Anti-aliasing modes, comma-separated (none, ssaa:N, msaa:N, csaa:CxS);
+    /// each is measured against a ssaa:256 reference and plotted in aa_cost.svg
+    /// [default: none, without a reference].
+    #[arg(long, value_delimiter = ',', value_parser = |s: &str| continuum::AaMode::parse(s).map_err(|e| e.message))]
+    aa: Vec<AaMode>,
     /// Folder for results.json and results.csv.
     #[arg(long)]
     out: PathBuf,
@@ -116,6 +126,15 @@ struct Row {
     agrees: bool,
     /// Pixels whose triangle id differs from 3dr-brute's (peers are not watertight).
     pixels_differing_from_3dr_brute: Option<u64>,
+    /// Time against the same algorithm without anti-aliasing (when measured).
+    ratio_to_aa_none: Option<f64>,
+    /// Shading evaluations and coverage samples of the render.
+    shading_samples: u64,
+    coverage_samples: u64,
+    /// Error against the ssaa:256 reference (with `--aa`).
+    psnr: Option<f64>,
+    psnr_edges: Option<f64>,
+    flip_mean: Option<f64>,
 }
 
 impl Row {
@@ -147,6 +166,12 @@ impl Row {
             hashes: Value::Null,
             agrees: false,
             pixels_differing_from_3dr_brute: None,
+            ratio_to_aa_none: None,
+            shading_samples: 0,
+            coverage_samples: 0,
+            psnr: None,
+            psnr_edges: None,
+            flip_mean: None,
         }
     }
 
@@ -160,6 +185,12 @@ impl Row {
     fn hashes(mut self, hashes: Value) -> Row {
         self.hashes = hashes;
         self
+    }
+
+    fn error(&mut self, e: ImageError) {
+        self.psnr = e.psnr;
+        self.psnr_edges = e.psnr_edges;
+        self.flip_mean = Some(e.flip_mean);
     }
 }
 
@@ -193,7 +224,12 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         .context("building the thread pool")?;
     let (width, height) = args.size;
 
-    let total_steps = (scene_args.len() * entries.len()) as u64;
+    let modes = if args.aa.is_empty() {
+        vec![AaMode::None]
+    } else {
+        args.aa.clone()
+    };
+    let total_steps = (scene_args.len() * modes.len() * entries.len()) as u64;
     let progress = indicatif::ProgressBar::new(total_steps).with_style(
         indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} [{elapsed}]")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
@@ -214,28 +250,51 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         let scene_name = prepared.scene.name.clone();
         let view = View::new(&camera, width, height, prepared.default_near)
             .map_err(|e| CliError::Usage(format!("--camera: {e}")))?;
-        let mut scene_rows: Vec<(Row, Vec<u32>)> = Vec::new();
-        for &entry in &entries {
-            progress.set_message(format!("{scene_name}: {}", entry.name()));
-            let (row, ids) = match entry {
-                Entry::Algorithm(a) => {
-                    measure_algorithm(&pool, &prepared, &camera, a, args, threads, &scene_name)?
+        let reference = if args.aa.is_empty() {
+            None
+        } else {
+            progress.set_message(format!("{scene_name}: {} reference", continuum::aa::REFERENCE));
+            Some(pool.install(|| Reference::render(&prepared, &camera, args.size))?)
+        };
+        let first_row = rows.len();
+        for &mode in &modes {
+            let mut mode_rows: Vec<(Row, Vec<u64>)> = Vec::new();
+            for &entry in &entries {
+                progress.set_message(format!("{scene_name} {mode}: {}", entry.name()));
+                let measured = match entry {
+                    Entry::Algorithm(a) => Some(measure_algorithm(
+                        &pool,
+                        &prepared,
+                        &camera,
+                        (a, mode),
+                        args,
+                        threads,
+                        &scene_name,
+                    )?),
+                    // Peers render one sample per pixel.
+                    Entry::Peer(p) if mode == AaMode::None => Some(measure_peer(
+                        &pool,
+                        &prepared,
+                        &view,
+                        p,
+                        args.repeat,
+                        threads,
+                        &scene_name,
+                    )?),
+                    Entry::Peer(_) => None,
+                };
+                if let Some(Measured { mut row, keys, fb }) = measured {
+                    if let (Some(r), Some(fb)) = (&reference, &fb) {
+                        row.error(r.error_of(fb));
+                    }
+                    mode_rows.push((row, keys));
                 }
-                Entry::Peer(p) => measure_peer(
-                    &pool,
-                    &prepared,
-                    &view,
-                    p,
-                    args.repeat,
-                    threads,
-                    &scene_name,
-                )?,
-            };
-            scene_rows.push((row, ids));
-            progress.inc(1);
+                progress.inc(1);
+            }
+            fill_relations(&mut mode_rows);
+            rows.extend(mode_rows.into_iter().map(|(r, _)| r));
         }
-        fill_relations(&mut scene_rows);
-        rows.extend(scene_rows.into_iter().map(|(r, _)| r));
+        fill_aa_ratios(&mut rows[first_row..]);
     }
     progress.finish_and_clear();
 
@@ -247,6 +306,23 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
     let text = serde_json::to_string_pretty(&doc).context("encoding results")?;
     std::fs::write(args.out.join("results.json"), &text).context("writing results.json")?;
     write_csv(&args.out.join("results.csv"), &rows)?;
+    if !args.aa.is_empty() {
+        let path = args.out.join("aa_cost.svg");
+        let points: Vec<AaPoint> = rows
+            .iter()
+            .filter_map(|r| {
+                Some(AaPoint {
+                    scene: r.scene.clone(),
+                    algorithm: r.algorithm.clone(),
+                    aa: r.aa.clone(),
+                    median_ms: r.median_ms,
+                    flip_mean: r.flip_mean?,
+                })
+            })
+            .collect();
+        std::fs::write(&path, aa_cost_svg(&points))
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
     if args.json {
         println!("{text}");
     } else {
@@ -255,22 +331,86 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// The reference of a scene: `ssaa:256` by `3dr-bin`, and the pixels where the
+/// image without anti-aliasing differs from it (where anti-aliasing matters).
+struct Reference {
+    color: Vec<[u8; 4]>,
+    edges: Vec<bool>,
+    width: u32,
+    height: u32,
+}
+
+impl Reference {
+    fn render(
+        prepared: &PreparedScene,
+        camera: &continuum::Camera,
+        (width, height): (u32, u32),
+    ) -> Result<Reference, CliError> {
+        let request = |aa| RenderRequest {
+            algorithm: AlgorithmId::ThreeDBin,
+            oracles: None,
+            camera: camera.clone(),
+            width,
+            height,
+            aa,
+        };
+        let run = |aa| {
+            render(prepared, &request(aa))
+                .map(|o| o.framebuffer.color)
+                .map_err(|e| CliError::Usage(format!("--{e}")))
+        };
+        let color = run(continuum::aa::REFERENCE)?;
+        let edges = metrics::differing_pixels(&run(AaMode::None)?, &color);
+        Ok(Reference {
+            color,
+            edges,
+            width,
+            height,
+        })
+    }
+
+    fn error_of(&self, fb: &Framebuffer) -> ImageError {
+        metrics::compare(&self.color, &fb.color, &self.edges, self.width, self.height)
+    }
+}
+
+/// Each row's time against the same scene and algorithm without anti-aliasing.
+fn fill_aa_ratios(rows: &mut [Row]) {
+    let none: HashMap<String, f64> = rows
+        .iter()
+        .filter(|r| r.aa == "none")
+        .map(|r| (r.algorithm.clone(), r.median_ms))
+        .collect();
+    for r in rows {
+        r.ratio_to_aa_none = none.get(&r.algorithm).map(|base| r.median_ms / base);
+    }
+}
+
+/// One measured row, the key that decides agreement (per pixel: the triangle
+/// id, or the digest of every sample's id under anti-aliasing) and, for our
+/// own algorithms, the framebuffer.
+struct Measured {
+    row: Row,
+    keys: Vec<u64>,
+    fb: Option<Framebuffer>,
+}
+
 fn measure_algorithm(
     pool: &rayon::ThreadPool,
     prepared: &PreparedScene,
     camera: &continuum::Camera,
-    algorithm: AlgorithmId,
+    (algorithm, aa): (AlgorithmId, AaMode),
     args: &CompareArgs,
     threads: usize,
     scene: &str,
-) -> Result<(Row, Vec<u32>), CliError> {
+) -> Result<Measured, CliError> {
     let request = RenderRequest {
         algorithm,
         oracles: None,
         camera: camera.clone(),
         width: args.size.0,
         height: args.size.1,
-        aa: continuum::AaMode::None,
+        aa,
     };
     let mut out = pool
         .install(|| render(prepared, &request))
@@ -282,7 +422,7 @@ fn measure_algorithm(
             .map_err(|e| CliError::Usage(format!("--{e}")))?;
         times.push(out.stats.time_ms.total);
     }
-    let row = Row::timed(
+    let mut row = Row::timed(
         scene,
         algorithm.as_str(),
         (args.size.0, args.size.1),
@@ -295,7 +435,19 @@ fn measure_algorithm(
         serde_json::to_value(&out.stats).unwrap_or(Value::Null),
     )
     .hashes(serde_json::to_value(&out.hashes).unwrap_or(Value::Null));
-    Ok((row, out.framebuffer.triangle_id))
+    row.shading_samples = out.stats.shading_samples;
+    row.coverage_samples = out.stats.coverage_samples;
+    let fb = out.framebuffer;
+    let keys = if fb.sample_digest.is_empty() {
+        fb.triangle_id.iter().map(|&t| u64::from(t)).collect()
+    } else {
+        fb.sample_digest.clone()
+    };
+    Ok(Measured {
+        row,
+        keys,
+        fb: Some(fb),
+    })
 }
 
 fn measure_peer(
@@ -306,11 +458,11 @@ fn measure_peer(
     repeat: u32,
     threads: usize,
     scene: &str,
-) -> Result<(Row, Vec<u32>), CliError> {
+) -> Result<Measured, CliError> {
     let run = pool
         .install(|| run_peer(peer, prepared, view, repeat))
         .map_err(|e| CliError::Usage(format!("--algorithms: {e}")))?;
-    let row = Row::timed(
+    let mut row = Row::timed(
         scene,
         peer.as_str(),
         (view.width, view.height),
@@ -322,13 +474,19 @@ fn measure_peer(
         "none",
         json!({ "bvh_build_ms": run.build_ms }),
     );
-    Ok((row, run.triangle_id))
+    row.coverage_samples = u64::from(view.width) * u64::from(view.height);
+    Ok(Measured {
+        row,
+        keys: run.triangle_id.iter().map(|&t| u64::from(t)).collect(),
+        fb: None,
+    })
 }
 
-/// Ratios to 2dr-brute, family agreement and peer differences within one scene.
-fn fill_relations(rows: &mut [(Row, Vec<u32>)]) {
+/// Ratios to 2dr-brute, family agreement and peer differences within one scene
+/// and anti-aliasing mode.
+fn fill_relations(rows: &mut [(Row, Vec<u64>)]) {
     let find =
-        |rows: &[(Row, Vec<u32>)], name: &str| rows.iter().position(|(r, _)| r.algorithm == name);
+        |rows: &[(Row, Vec<u64>)], name: &str| rows.iter().position(|(r, _)| r.algorithm == name);
     let base = find(rows, "2dr-brute").map(|i| {
         let r = &rows[i].0;
         (r.median_ms, r.stats["predicted_instructions"].as_f64())
@@ -388,7 +546,7 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
     let mut f =
         std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
     let mut text = String::from(
-        "scene,algorithm,width,height,threads,median_ms,min_ms,max_ms,ratio_to_2dr_brute,predicted_ratio,rays_per_second,triangle_setups,edge_evaluations,bvh_nodes_visited,agrees,pixels_differing_from_3dr_brute,triangle_id_hash\n",
+        "scene,algorithm,aa,width,height,threads,median_ms,min_ms,max_ms,ratio_to_2dr_brute,predicted_ratio,rays_per_second,triangle_setups,edge_evaluations,bvh_nodes_visited,agrees,pixels_differing_from_3dr_brute,triangle_id_hash,ratio_to_aa_none,shading_samples,coverage_samples,psnr,psnr_edges,flip_mean\n",
     );
     let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.4}"));
     for r in rows {
@@ -399,9 +557,10 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
                 .map_or(String::new(), |v| v.to_string())
         };
         text.push_str(&format!(
-            "{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{:.0},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{:.0},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             r.scene,
             r.algorithm,
+            r.aa,
             r.width,
             r.height,
             r.threads,
@@ -421,6 +580,12 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
                 .get("triangle_id")
                 .and_then(Value::as_str)
                 .unwrap_or(""),
+            opt(r.ratio_to_aa_none),
+            r.shading_samples,
+            r.coverage_samples,
+            opt(r.psnr),
+            opt(r.psnr_edges),
+            r.flip_mean.map_or(String::new(), |v| format!("{v:.6}")),
         ));
     }
     f.write_all(text.as_bytes())
@@ -430,19 +595,33 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
 
 fn print_table(rows: &[Row]) {
     println!(
-        "{:<12} {:<18} {:>10} {:>8} {:>9} {:>12} {:>7}",
-        "scene", "algorithm", "median ms", "ratio", "predicted", "Mrays/s", "agrees"
+        "{:<12} {:<18} {:<10} {:>10} {:>8} {:>9} {:>7} {:>9} {:>9} {:>7} {:>7}",
+        "scene",
+        "algorithm",
+        "aa",
+        "median ms",
+        "ratio",
+        "predicted",
+        "x none",
+        "PSNR dB",
+        "edges dB",
+        "FLIP",
+        "agrees"
     );
     for r in rows {
         let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.2}"));
         println!(
-            "{:<12} {:<18} {:>10.2} {:>8} {:>9} {:>12.2} {:>7}",
+            "{:<12} {:<18} {:<10} {:>10.2} {:>8} {:>9} {:>7} {:>9} {:>9} {:>7} {:>7}",
             r.scene,
             r.algorithm,
+            r.aa,
             r.median_ms,
             opt(r.ratio_to_2dr_brute),
             opt(r.predicted_ratio),
-            r.rays_per_second / 1e6,
+            opt(r.ratio_to_aa_none),
+            opt(r.psnr),
+            opt(r.psnr_edges),
+            r.flip_mean.map_or("-".to_string(), |v| format!("{v:.4}")),
             match r.pixels_differing_from_3dr_brute {
                 Some(d) => format!("{d} px"),
                 None => r.agrees.to_string(),

@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 
 mod cli_render;
 mod compare;
+mod plot;
 mod serve;
 
 #[derive(Parser, Debug)]

@@ -66,6 +66,8 @@ pub struct SamplePattern {
     pub shade_per_sample: bool,
     /// The smallest box holding every position.
     pub span: SampleSpan,
+    /// Per coverage position, the nearest stored position (itself if stored).
+    pub nearest_stored: Vec<u8>,
 }
 
 /// The box of sample offsets inside a pixel: a sample of pixel `p` lies in
@@ -105,12 +107,26 @@ impl SamplePattern {
                 span.hi[a] = span.hi[a].max(p[a]);
             }
         }
+        let distance = |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
+        let nearest_stored = positions
+            .iter()
+            .enumerate()
+            .map(|(c, &p)| {
+                if c < stored || stored == 0 {
+                    return c.min(255) as u8;
+                }
+                (0..stored)
+                    .min_by(|&a, &b| distance(p, positions[a]).total_cmp(&distance(p, positions[b])))
+                    .unwrap_or(0) as u8
+            })
+            .collect();
         SamplePattern {
             mode,
             positions,
             stored,
             shade_per_sample: mode.shades_per_sample(),
             span,
+            nearest_stored,
         }
     }
 

@@ -8,10 +8,14 @@
 //!   holds it.
 //! - CSAA: a stored position as above. A coverage-only position sees, of the
 //!   triangles stored in the pixel whose coverage mask holds it, the nearest by
-//!   its stored depth (ties to the smaller id); if none covers it, the
-//!   background when a stored sample is background, else it is unknown and left
-//!   out of the mean (the information CSAA discards). This depends only on what
-//!   the stored samples hold, so it is the same in every algorithm.
+//!   its stored depth (ties to the smaller id); if none covers it (its surface
+//!   won no stored sample, or it sees the background), the surface of the
+//!   nearest stored position. (Hardware CSAA shows the background there when a
+//!   stored sample is background; on meshes of small triangles that turns every
+//!   triangle that lost its stored samples into background along silhouettes —
+//!   measured on `bunny` at 320×240: 36.5 dB against 40.4 dB with this rule.) This depends only on what the stored samples
+//!   hold — not on drawing order or culling — so it is the same in every
+//!   algorithm.
 
 use glam::Vec3;
 
@@ -115,8 +119,11 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
             } else {
                 slot_color[..stored].iter().sum()
             };
-            let mut known = stored as u32;
             if pattern.has_coverage_only() {
+                if uniform {
+                    let first = slot_color[0];
+                    slot_color[1..stored].fill(first);
+                }
                 // Each stored triangle's coverage over the pixel: the union of
                 // what each of its stored samples recorded.
                 let mut union = [0u32; MAX_CSAA_STORED];
@@ -138,23 +145,18 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
                             best = Some(s);
                         }
                     }
-                    let seen = match best {
-                        Some(s) => Some(slot_color[s]),
+                    sum += match best {
+                        Some(s) => slot_color[s],
                         None if view.sphere.is_some()
                             && view.ray(x as f32 + ox, y as f32 + oy).is_none() =>
                         {
-                            Some(outside)
+                            outside
                         }
-                        None if (0..stored).any(|s| id_at(s) == BACKGROUND) => Some(background),
-                        None => None,
+                        None => slot_color[pattern.nearest_stored[c] as usize],
                     };
-                    if let Some(color) = seen {
-                        sum += color;
-                        known += 1;
-                    }
                 }
             }
-            out.color[i] = encode_rgb(sum / known as f32);
+            out.color[i] = encode_rgb(sum / pattern.coverage() as f32);
             // 3. The digest of every sample's id (and mask).
             let mut digest = DIGEST_SEED;
             for s in 0..stored {
