@@ -148,7 +148,8 @@ enum Samples {
 /// along a row, lane `l` of group `g` is position `c` of pixel `k` with
 /// `k·C + c = 8g + l`, so small patterns share a group between pixels. Covered
 /// stored samples go through the depth test; under CSAA a stored sample that
-/// wins keeps the triangle's mask over all positions of its pixel.
+/// wins keeps the triangle's mask over all positions of its pixel (coverage-only
+/// positions are decided by [`Coverage::covers8`], without depth).
 fn sample_pattern<T: Coverage>(
     tile: &mut TileBuffer,
     tri: &T,
@@ -189,10 +190,26 @@ fn sample_pattern<T: Coverage>(
                     xs[l] = (x0 + (p >> shift) as u32) as f32 + ox;
                     ys[l] = y as f32 + oy;
                 }
-                let (mask, w) = match how {
-                    Samples::Test => tri.sample_points8(xs, ys),
-                    Samples::Inside => tri.depth_inside8(xs, ys),
+                // Lanes at coverage-only positions (CSAA) need coverage, not depth.
+                let mut coverage_only = 0u8;
+                if masked {
+                    for l in 0..lanes {
+                        if (q + l) & (count - 1) >= stored {
+                            coverage_only |= 1 << l;
+                        }
+                    }
+                }
+                let (mut mask, w) = if coverage_only == 0xff {
+                    (0, [0.0; 8])
+                } else {
+                    match how {
+                        Samples::Test => tri.sample_points8(xs, ys),
+                        Samples::Inside => tri.depth_inside8(xs, ys),
+                    }
                 };
+                if coverage_only != 0 {
+                    mask = (mask & !coverage_only) | (tri.covers8(xs, ys) & coverage_only);
+                }
                 let mut mask = u32::from(mask) & ((1 << lanes) - 1);
                 covered += mask.count_ones();
                 while mask != 0 {

@@ -67,8 +67,29 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
         }
     }
     let anti_aliased = pattern.coverage() > 1;
+    // Layer by layer (contiguous, independent per pixel): the digest of every
+    // sample's id (and mask), and whether a pixel's stored samples all hold
+    // one triangle.
+    let mut uniform = vec![!pattern.shade_per_sample; pixels];
     if anti_aliased {
-        out.sample_digest = vec![0; pixels];
+        let ids = &tile.triangle_id;
+        out.sample_digest = vec![DIGEST_SEED; pixels];
+        for (s, layer) in ids.chunks_exact(pixels).enumerate() {
+            for (d, &id) in out.sample_digest.iter_mut().zip(layer) {
+                *d = mix(*d, id);
+            }
+            if pattern.has_coverage_only() {
+                let masks = &tile.masks[s * pixels..(s + 1) * pixels];
+                for (d, &m) in out.sample_digest.iter_mut().zip(masks) {
+                    *d = mix(*d, m);
+                }
+            }
+            if s > 0 && !pattern.shade_per_sample {
+                for ((u, &id), &first) in uniform.iter_mut().zip(layer).zip(&ids[..pixels]) {
+                    *u &= id == first;
+                }
+            }
+        }
     }
     let mut slot_color = [Vec3::ZERO; MAX_STORED];
     for y in tile.y0..tile.y1 {
@@ -80,9 +101,7 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
             // hold the same triangle and need not be shaded apart).
             // (Background samples of a non-planar view may lie on both sides
             // of the viewport's border, so they are not taken as one.)
-            let uniform = !pattern.shade_per_sample
-                && (id_at(0) != BACKGROUND || view.sphere.is_none())
-                && (1..stored).all(|s| id_at(s) == id_at(0));
+            let uniform = uniform[i] && (id_at(0) != BACKGROUND || view.sphere.is_none());
             for s in 0..if uniform { 1 } else { stored } {
                 let id = id_at(s);
                 if !pattern.shade_per_sample
@@ -114,59 +133,67 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
                 };
                 continue;
             }
-            let mut sum: Vec3 = if uniform {
-                slot_color[0] * stored as f32
+            out.color[i] = encode_rgb(if uniform && view.sphere.is_none() {
+                // Every coverage sample sees this one surface.
+                slot_color[0]
             } else {
-                slot_color[..stored].iter().sum()
-            };
-            if pattern.has_coverage_only() {
                 if uniform {
                     let first = slot_color[0];
                     slot_color[1..stored].fill(first);
                 }
-                // Each stored triangle's coverage over the pixel: the union of
-                // what each of its stored samples recorded.
-                let mut union = [0u32; MAX_CSAA_STORED];
-                for s in 0..stored {
-                    for t in 0..stored {
-                        if id_at(t) == id_at(s) {
-                            union[s] |= tile.masks[t * pixels + i];
-                        }
-                    }
-                }
-                for (c, &[ox, oy]) in pattern.positions.iter().enumerate().skip(stored) {
-                    let mut best: Option<usize> = None;
-                    for s in 0..stored {
-                        let id = id_at(s);
-                        if id != BACKGROUND
-                            && union[s] & (1 << c) != 0
-                            && best.is_none_or(|b| wins_depth_test(depth_at(s), id, depth_at(b), id_at(b)))
-                        {
-                            best = Some(s);
-                        }
-                    }
-                    sum += match best {
-                        Some(s) => slot_color[s],
-                        None if view.sphere.is_some()
-                            && view.ray(x as f32 + ox, y as f32 + oy).is_none() =>
-                        {
-                            outside
-                        }
-                        None => slot_color[pattern.nearest_stored[c] as usize],
-                    };
-                }
-            }
-            out.color[i] = encode_rgb(sum / pattern.coverage() as f32);
-            // 3. The digest of every sample's id (and mask).
-            let mut digest = DIGEST_SEED;
-            for s in 0..stored {
-                digest = mix(digest, id_at(s));
-                if pattern.has_coverage_only() {
-                    digest = mix(digest, tile.masks[s * pixels + i]);
-                }
-            }
-            out.sample_digest[i] = digest;
+                mixed_color(tile, view, i, (x, y), &mut slot_color, outside) / pattern.coverage() as f32
+            });
         }
     }
     out
+}
+
+/// The sum of what every coverage sample of pixel `i` (at `(x, y)`) sees, given
+/// the colours of its stored samples (`slot_color`, overwritten for CSAA).
+fn mixed_color(
+    tile: &TileBuffer,
+    view: &View,
+    i: usize,
+    (x, y): (u32, u32),
+    slot_color: &mut [Vec3; MAX_STORED],
+    outside: Vec3,
+) -> Vec3 {
+    let pattern = tile.pattern;
+    let (stored, pixels) = (pattern.stored, tile.pixels);
+    let id_at = |s: usize| tile.triangle_id[s * pixels + i];
+    let depth_at = |s: usize| tile.depth[s * pixels + i];
+    let mut sum: Vec3 = slot_color[..stored].iter().sum();
+    if !pattern.has_coverage_only() {
+        return sum;
+    }
+    // Each stored triangle's coverage over the pixel: the union of what each of
+    // its stored samples recorded.
+    let mut union = [0u32; MAX_CSAA_STORED];
+    for s in 0..stored {
+        for t in 0..stored {
+            if id_at(t) == id_at(s) {
+                union[s] |= tile.masks[t * pixels + i];
+            }
+        }
+    }
+    for (c, &[ox, oy]) in pattern.positions.iter().enumerate().skip(stored) {
+        let mut best: Option<usize> = None;
+        for s in 0..stored {
+            let id = id_at(s);
+            if id != BACKGROUND
+                && union[s] & (1 << c) != 0
+                && best.is_none_or(|b| wins_depth_test(depth_at(s), id, depth_at(b), id_at(b)))
+            {
+                best = Some(s);
+            }
+        }
+        sum += match best {
+            Some(s) => slot_color[s],
+            None if view.sphere.is_some() && view.ray(x as f32 + ox, y as f32 + oy).is_none() => {
+                outside
+            }
+            None => slot_color[pattern.nearest_stored[c] as usize],
+        };
+    }
+    sum
 }

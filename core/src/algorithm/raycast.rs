@@ -11,6 +11,7 @@ use rayon::prelude::*;
 use glam::Vec3;
 
 use super::{Pass, TileContext};
+use crate::aa::SamplePattern;
 use crate::camera::View;
 use crate::edge::Coverage;
 use crate::framebuffer::{BACKGROUND, Framebuffer, TileBuffer, wins_depth_test};
@@ -131,13 +132,7 @@ fn cast_band<T: Coverage>(
                                 continue;
                             };
                             tile.edge_evals[i] += pattern.coverage() as u32;
-                            let mut mask = 0;
-                            for (c, &[ox, oy]) in pattern.positions.iter().enumerate() {
-                                if tri.sample(x as f32 + ox, y as f32 + oy).is_some() {
-                                    mask |= 1 << c;
-                                }
-                            }
-                            mask
+                            coverage_mask(tri, pattern, x, y)
                         }
                     };
                 }
@@ -145,4 +140,30 @@ fn cast_band<T: Coverage>(
         }
     }
     nodes
+}
+
+/// The coverage mask of `tri` over pixel `(x, y)` as the rasterizers compute it:
+/// [`Coverage::sample`] at stored positions, [`Coverage::covers8`] at
+/// coverage-only ones.
+fn coverage_mask<T: Coverage>(tri: &T, pattern: &SamplePattern, x: u32, y: u32) -> u32 {
+    let mut mask = 0;
+    for (g, group) in pattern.positions.chunks(8).enumerate() {
+        let (mut xs, mut ys) = ([0.0; 8], [0.0; 8]);
+        for l in 0..8 {
+            let [ox, oy] = group[l.min(group.len() - 1)];
+            xs[l] = x as f32 + ox;
+            ys[l] = y as f32 + oy;
+        }
+        let covers = tri.covers8(xs, ys);
+        for l in 0..group.len() {
+            let c = g * 8 + l;
+            let bit = if c < pattern.stored {
+                tri.sample(xs[l], ys[l]).is_some()
+            } else {
+                covers >> l & 1 == 1
+            };
+            mask |= u32::from(bit) << c;
+        }
+    }
+    mask
 }

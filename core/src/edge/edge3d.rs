@@ -198,6 +198,18 @@ impl LinearEdges for Triangle3D {
 impl Triangle3D {
     #[inline(always)]
     fn sample_lanes(&self, x: f32x8, y: f32x8) -> (u8, [f32; 8]) {
+        let facing = self.facing_lanes(x, y);
+        let inside = self.edges_lanes(x, y) & facing.simd_gt(f32x8::ZERO);
+        let mask = inside.to_bitmask() as u8;
+        if mask == 0 {
+            return (0, [0.0; 8]);
+        }
+        self.depth_lanes(x, y, facing, mask)
+    }
+
+    /// All-ones lanes where the three edges (with the tie rule) hold the point.
+    #[inline(always)]
+    fn edges_lanes(&self, x: f32x8, y: f32x8) -> f32x8 {
         let zero = f32x8::ZERO;
         let mut inside = f32x8::from([f32::from_bits(u32::MAX); 8]);
         for k in 0..3 {
@@ -210,13 +222,7 @@ impl Triangle3D {
             };
             inside &= e.simd_gt(zero) | on_edge;
         }
-        let facing = self.facing_lanes(x, y);
-        inside &= facing.simd_gt(zero);
-        let mask = inside.to_bitmask() as u8;
-        if mask == 0 {
-            return (0, [0.0; 8]);
-        }
-        self.depth_lanes(x, y, facing, mask)
+        inside
     }
 
     #[inline(always)]
@@ -264,6 +270,14 @@ impl Coverage for Triangle3D {
     #[inline(always)]
     fn sample_points8(&self, x: [f32; 8], y: [f32; 8]) -> (u8, [f32; 8]) {
         self.sample_lanes(f32x8::from(x), f32x8::from(y))
+    }
+
+    /// Edges and facing, no division.
+    #[inline(always)]
+    fn covers8(&self, x: [f32; 8], y: [f32; 8]) -> u8 {
+        let (x, y) = (f32x8::from(x), f32x8::from(y));
+        let inside = self.edges_lanes(x, y) & self.facing_lanes(x, y).simd_gt(f32x8::ZERO);
+        inside.to_bitmask() as u8
     }
 
     #[inline(always)]

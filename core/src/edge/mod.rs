@@ -87,6 +87,15 @@ pub trait Coverage {
         (mask, depth)
     }
 
+    /// Does the triangle cover each of eight points, depth aside (CSAA's
+    /// coverage-only positions): inside the edges by the tie rule, and in front
+    /// of the eye — [`Coverage::sample`] without its `near` test. The default
+    /// keeps that test (for edge functions whose coverage needs no depth).
+    #[inline(always)]
+    fn covers8(&self, x: [f32; 8], y: [f32; 8]) -> u8 {
+        self.sample_points8(x, y).0
+    }
+
     /// [`Coverage::depth_inside`] for eight points of a block found inside.
     #[inline(always)]
     fn depth_inside8(&self, x: [f32; 8], y: [f32; 8]) -> (u8, [f32; 8]) {
