@@ -227,6 +227,9 @@ fn sample_pattern<T: Coverage>(
                 }
             }
             if masked {
+                for (any, &mask) in tile.covered_any[i..i + n].iter_mut().zip(&masks[..n]) {
+                    *any |= mask;
+                }
                 for (k, &mask) in masks[..n].iter().enumerate() {
                     let mut at_stored = mask & ((1 << stored) - 1);
                     while at_stored != 0 {

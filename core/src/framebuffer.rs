@@ -149,6 +149,10 @@ pub struct TileBuffer<'p> {
     pub masks: Vec<u32>,
     /// Per pixel: sample-against-triangle tests.
     pub edge_evals: Vec<u32>,
+    /// CSAA, per pixel: the coverage positions any triangle rasterized there
+    /// covers (read only where a stored sample is background, where no
+    /// algorithm culls a triangle, so every algorithm sees the same bits).
+    pub covered_any: Vec<u32>,
     /// CSAA scratch of the coverage kernel: masks of [`SCRATCH_PIXELS`] pixels
     /// and the depths at their stored positions (empty otherwise).
     pub(crate) scratch_masks: Vec<u32>,
@@ -182,6 +186,11 @@ impl<'p> TileBuffer<'p> {
                 Vec::new()
             },
             edge_evals: vec![0; pixels],
+            covered_any: if pattern.has_coverage_only() {
+                vec![0; pixels]
+            } else {
+                Vec::new()
+            },
             scratch_masks: if pattern.has_coverage_only() {
                 vec![0; SCRATCH_PIXELS]
             } else {
@@ -196,6 +205,32 @@ impl<'p> TileBuffer<'p> {
             hiz_columns,
             depth_lowered: false,
         }
+    }
+
+    /// The same buffers for the pixels `x0..x1 × y0..y1`, cleared (their
+    /// memory kept).
+    pub fn reset(&mut self, x0: u32, y0: u32, x1: u32, y1: u32) {
+        let pixels = ((x1 - x0) * (y1 - y0)) as usize;
+        let samples = pixels * self.pattern.stored;
+        let refill = |v: &mut Vec<u32>, n: usize, value: u32| {
+            v.clear();
+            v.resize(n, value);
+        };
+        (self.x0, self.y0, self.x1, self.y1, self.pixels) = (x0, y0, x1, y1, pixels);
+        self.depth.clear();
+        self.depth.resize(samples, f32::INFINITY);
+        refill(&mut self.triangle_id, samples, BACKGROUND);
+        refill(&mut self.coverage_writes, samples, 0);
+        refill(&mut self.edge_evals, pixels, 0);
+        if self.pattern.has_coverage_only() {
+            refill(&mut self.masks, samples, 0);
+            refill(&mut self.covered_any, pixels, 0);
+        }
+        self.hiz_columns = (x1 - x0).div_ceil(HIZ_CELL);
+        let cells = (self.hiz_columns * (y1 - y0).div_ceil(HIZ_CELL)) as usize;
+        self.hiz.clear();
+        self.hiz.resize(cells, f32::INFINITY);
+        self.depth_lowered = false;
     }
 
     /// The tile's pixels as an inclusive rectangle.

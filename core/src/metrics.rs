@@ -25,10 +25,7 @@ pub struct ImageError {
 /// Pixels where two images differ in any channel: where anti-aliasing changes
 /// anything, when `a` is rendered without it and `b` is the reference.
 pub fn differing_pixels(a: &[[u8; 4]], b: &[[u8; 4]]) -> Vec<bool> {
-    a.iter()
-        .zip(b)
-        .map(|(p, q)| p[..3] != q[..3])
-        .collect()
+    a.iter().zip(b).map(|(p, q)| p[..3] != q[..3]).collect()
 }
 
 /// PSNR in dB over the RGB channels of the pixels where `mask` is set (every
@@ -55,7 +52,8 @@ pub fn psnr(reference: &[[u8; 4]], test: &[[u8; 4]], mask: Option<&[bool]>) -> O
 
 /// Mean FLIP error of `test` against `reference` (both `width × height` sRGB).
 pub fn flip_mean(reference: &[[u8; 4]], test: &[[u8; 4]], width: u32, height: u32) -> f64 {
-    let rgb = |img: &[[u8; 4]]| -> Vec<u8> { img.iter().flat_map(|p| [p[0], p[1], p[2]]).collect() };
+    let rgb =
+        |img: &[[u8; 4]]| -> Vec<u8> { img.iter().flat_map(|p| [p[0], p[1], p[2]]).collect() };
     let error = nv_flip::flip(
         nv_flip::FlipImageRgb8::with_data(width, height, &rgb(reference)),
         nv_flip::FlipImageRgb8::with_data(width, height, &rgb(test)),

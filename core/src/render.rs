@@ -143,6 +143,16 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
         )
         .into());
     }
+    if pipeline.samples().is_some_and(|s| s.incremental) && request.aa != AaMode::None {
+        return Err(FieldError::new(
+            "oracles",
+            format!(
+                "incremental: the double-incremental scheme steps along rows of pixel centres; not with aa {}",
+                request.aa
+            ),
+        )
+        .into());
+    }
     algorithm::run(pipeline, scene, &view, &pattern, &mut fb, &mut stats);
 
     stats.edge_evaluations = fb.edge_evals.iter().map(|&e| u64::from(e)).sum();

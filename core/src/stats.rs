@@ -107,7 +107,11 @@ impl Hashes {
         let samples = if fb.sample_digest.is_empty() {
             triangle_id.clone()
         } else {
-            let digests: Vec<u8> = fb.sample_digest.iter().flat_map(|v| v.to_le_bytes()).collect();
+            let digests: Vec<u8> = fb
+                .sample_digest
+                .iter()
+                .flat_map(|v| v.to_le_bytes())
+                .collect();
             hex(&digests)
         };
         Hashes {

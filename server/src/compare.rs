@@ -12,8 +12,8 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use continuum::peer::{PeerId, run_peer};
 use continuum::metrics::{self, ImageError};
+use continuum::peer::{PeerId, run_peer};
 use continuum::request::{parse_algorithm, parse_size};
 use continuum::{AaMode, AlgorithmId, Framebuffer, PreparedScene, RenderRequest, View, render};
 use serde::Serialize;
@@ -253,7 +253,10 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         let reference = if args.aa.is_empty() {
             None
         } else {
-            progress.set_message(format!("{scene_name}: {} reference", continuum::aa::REFERENCE));
+            progress.set_message(format!(
+                "{scene_name}: {} reference",
+                continuum::aa::REFERENCE
+            ));
             Some(pool.install(|| Reference::render(&prepared, &camera, args.size))?)
         };
         let first_row = rows.len();

@@ -74,12 +74,11 @@ pub fn aa_cost_svg(points: &[AaPoint]) -> String {
 }
 
 fn panel_svg(svg: &mut String, x0: f64, scene: &str, points: &[&AaPoint], algorithms: &[&str]) {
-    let (plot_w, plot_h) = (
-        PANEL_W - MARGIN_L - MARGIN_R,
-        PANEL_H - MARGIN_T - MARGIN_B,
-    );
+    let (plot_w, plot_h) = (PANEL_W - MARGIN_L - MARGIN_R, PANEL_H - MARGIN_T - MARGIN_B);
     let times = points.iter().map(|p| p.median_ms.max(1e-3));
-    let (t_min, t_max) = times.fold((f64::INFINITY, 0.0f64), |(lo, hi), t| (lo.min(t), hi.max(t)));
+    let (t_min, t_max) = times.fold((f64::INFINITY, 0.0f64), |(lo, hi), t| {
+        (lo.min(t), hi.max(t))
+    });
     let (lt0, lt1) = if t_min.is_finite() {
         let (a, b) = (t_min.log10(), t_max.log10());
         let pad = ((b - a) * 0.08).max(0.05);
@@ -150,7 +149,13 @@ fn panel_svg(svg: &mut String, x0: f64, scene: &str, points: &[&AaPoint], algori
     if front.len() > 1 {
         let path: Vec<String> = front
             .iter()
-            .map(|&i| format!("{:.1},{:.1}", sx(points[i].median_ms), sy(points[i].flip_mean)))
+            .map(|&i| {
+                format!(
+                    "{:.1},{:.1}",
+                    sx(points[i].median_ms),
+                    sy(points[i].flip_mean)
+                )
+            })
             .collect();
         let _ = writeln!(
             svg,

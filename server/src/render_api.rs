@@ -78,7 +78,12 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
             return Err(viewport.unsupported(algorithm).into());
         }
     }
-    let aa = body.aa.as_deref().map(parse_aa).transpose()?.unwrap_or_default();
+    let aa = body
+        .aa
+        .as_deref()
+        .map(parse_aa)
+        .transpose()?
+        .unwrap_or_default();
     let samples_per_pixel = aa.coverage_samples();
     if samples_per_pixel > state.limits.max_samples_per_pixel {
         return Err(FieldError::new(

@@ -244,9 +244,31 @@ fn render_json_and_png() {
             assert_eq!(status, StatusCode::OK, "{algorithm} {camera}: {doc}");
         }
     }
+    // Anti-aliasing: the mode comes back with its sample counts; too many
+    // samples per pixel for the server's limit is a 400 naming `aa`.
+    let (status, doc) = post(
+        &s,
+        "/api/render",
+        r#"{ "scene": "box", "algorithm": "3dr-bin", "size": "32x24", "aa": "csaa:16x4" }"#,
+    );
+    assert_eq!(status, StatusCode::OK, "{doc}");
+    assert_eq!(doc["aa"], "csaa:16x4");
+    assert_eq!(doc["stats"]["samples_per_pixel"], 16);
+    assert_eq!(doc["stats"]["stored_samples_per_pixel"], 4);
+    let small = state(Limits {
+        max_samples_per_pixel: 16,
+        ..Limits::default()
+    });
+    let (status, doc) = post(
+        &small,
+        "/api/render",
+        r#"{ "scene": "box", "algorithm": "3dr-bin", "size": "32x24", "aa": "ssaa:64" }"#,
+    );
+    assert_eq!(status, StatusCode::BAD_REQUEST, "{doc}");
+    assert_eq!(doc["field"], "aa");
     let (status, png) = get(
         &s,
-        "/api/render.png?scene=box&algorithm=2dr-brute&size=32x24",
+        "/api/render.png?scene=box&algorithm=2dr-brute&size=32x24&aa=msaa:4",
     );
     assert_eq!(status, StatusCode::OK);
     assert_eq!(&png[1..4], b"PNG");

@@ -319,6 +319,77 @@ fn compare_writes_results_with_the_documented_keys() {
 }
 
 #[test]
+fn compare_measures_anti_aliasing_against_the_reference() {
+    let dir = out_dir("compare-aa");
+    let out = continuum(&[
+        "compare",
+        "--scenes",
+        "box",
+        "--algorithms",
+        "3dr-bin,raycast,peer-obvhs",
+        "--aa",
+        "none,msaa:4,csaa:8x2",
+        "--size",
+        "48x32",
+        "--repeat",
+        "1",
+        "--out",
+        dir.to_str().expect("utf-8"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("results.json")).expect("results.json"))
+            .expect("JSON");
+    let rows = doc["rows"].as_array().expect("rows");
+    // The peer renders one sample per pixel: measured for `none` only.
+    assert_eq!(rows.len(), 2 * 3 + 1);
+    for row in rows {
+        let aa = row["aa"].as_str().expect("aa");
+        assert!(
+            row["coverage_samples"].as_u64().expect("count") >= 48 * 32,
+            "{row}"
+        );
+        // Peers give triangle ids, not images: no error to measure.
+        if row["algorithm"] != "peer-obvhs" {
+            assert!(row["flip_mean"].as_f64().is_some(), "{row}");
+            assert!(row["psnr"].as_f64().is_some(), "{row}");
+            assert_eq!(row["agrees"], true, "{row}");
+            assert!(row["ratio_to_aa_none"].as_f64().is_some(), "{row}");
+            assert!(row["shading_samples"].as_u64().expect("count") > 0, "{row}");
+        }
+        if aa == "msaa:4" {
+            assert_eq!(row["stats"]["samples_per_pixel"], 4, "{row}");
+        }
+    }
+    // Anti-aliasing brings the image closer to the reference.
+    let flip = |aa: &str| {
+        rows.iter()
+            .find(|r| r["algorithm"] == "3dr-bin" && r["aa"] == aa)
+            .and_then(|r| r["flip_mean"].as_f64())
+            .expect("row")
+    };
+    assert!(
+        flip("msaa:4") < flip("none"),
+        "{} {}",
+        flip("msaa:4"),
+        flip("none")
+    );
+    let svg = std::fs::read_to_string(dir.join("aa_cost.svg")).expect("aa_cost.svg");
+    assert!(svg.contains("<svg") && svg.contains("msaa:4") && svg.contains("<polyline"));
+    let bad = continuum(&["compare", "--aa", "msaa:3", "--out", "/tmp/never"]);
+    assert_eq!(bad.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        stderr.contains("--aa") && stderr.contains("valid modes"),
+        "{stderr}"
+    );
+}
+
+#[test]
 fn compare_refuses_unknown_algorithms() {
     let out = continuum(&["compare", "--algorithms", "zbuffer", "--out", "/tmp/never"]);
     assert_eq!(out.status.code(), Some(2));

@@ -68,6 +68,28 @@ pub fn render_with_oracles(
     .unwrap_or_else(|e| panic!("{algorithm} {oracles:?}: {e}"))
 }
 
+/// As [`render_with`], with an anti-aliasing mode.
+pub fn render_aa(
+    scene: &PreparedScene,
+    algorithm: AlgorithmId,
+    camera: &Camera,
+    (width, height): (u32, u32),
+    aa: continuum::AaMode,
+) -> RenderOutput {
+    render(
+        scene,
+        &RenderRequest {
+            algorithm,
+            oracles: None,
+            camera: camera.clone(),
+            width,
+            height,
+            aa,
+        },
+    )
+    .unwrap_or_else(|e| panic!("{algorithm} {aa}: {e}"))
+}
+
 /// Pixels where two triangle-id buffers differ, as `(x, y, a, b)`.
 pub fn id_differences(a: &RenderOutput, b: &RenderOutput) -> Vec<(u32, u32, u32, u32)> {
     let w = a.framebuffer.width;

@@ -14,7 +14,7 @@
 //! | `csaa:CxS` | C | S | once per pixel per triangle |
 //!
 //! The paper (§4, Fig. 8) adds MSAA and CSAA to 3D rasterization; the resolve
-//! ([`resolve`]) is a box filter over the coverage samples in linear light.
+//! (module `resolve`) is a box filter over the coverage samples in linear light.
 
 mod pattern;
 pub(crate) mod resolve;
@@ -58,10 +58,7 @@ impl AaMode {
     /// Parses the CLI's words: `none`, `ssaa:N`, `msaa:N`, `csaa:CxS`.
     pub fn parse(s: &str) -> Result<AaMode, FieldError> {
         let bad = |why: String| {
-            FieldError::new(
-                "aa",
-                format!("{why}; valid modes: {}", Self::valid_modes()),
-            )
+            FieldError::new("aa", format!("{why}; valid modes: {}", Self::valid_modes()))
         };
         let s = s.trim();
         if s.eq_ignore_ascii_case("none") {
@@ -187,12 +184,23 @@ mod tests {
     #[test]
     fn wrong_modes_name_the_field_and_list_the_valid_ones() {
         for bad in [
-            "", "msaa", "msaa:3", "ssaa:2", "csaa:16", "csaa:16x16", "csaa:4x8", "fxaa:4",
+            "",
+            "msaa",
+            "msaa:3",
+            "ssaa:2",
+            "csaa:16",
+            "csaa:16x16",
+            "csaa:4x8",
+            "fxaa:4",
             "msaa:x",
         ] {
             let e = AaMode::parse(bad).expect_err(bad);
             assert_eq!(e.field, "aa");
-            assert!(e.message.contains("valid modes: none, ssaa:4|16|64|256"), "{bad}: {}", e.message);
+            assert!(
+                e.message.contains("valid modes: none, ssaa:4|16|64|256"),
+                "{bad}: {}",
+                e.message
+            );
         }
     }
 }

@@ -8,8 +8,9 @@
 //!   Wang 1994) with a fixed seed: stratified over √N×√N cells *and* N-rooks,
 //!   with positions at the centres of the N×N sub-cells (multiples of 1/2N, exact
 //!   in `f32`).
-//! - `csaa:CxS` stores S of its C positions, chosen greedily farthest-first from
-//!   the position nearest the centre; they come first in the pattern.
+//! - `csaa:CxS` stores S of its C positions: for each position of the standard
+//!   S-sample pattern the nearest one, so its stored samples lie about where
+//!   `msaa:S` samples; they come first in the pattern.
 //!
 //! Because every pattern is N-rooks, the covered fraction of a pixel crossed by
 //! an axis-aligned edge differs from the covered area by at most 1/N.
@@ -66,8 +67,9 @@ pub struct SamplePattern {
     pub shade_per_sample: bool,
     /// The smallest box holding every position.
     pub span: SampleSpan,
-    /// Per coverage position, the nearest stored position (itself if stored).
-    pub nearest_stored: Vec<u8>,
+    /// CSAA: per coverage position, the stored positions nearest first
+    /// (empty when every position is stored).
+    pub nearest: Vec<Vec<u8>>,
 }
 
 /// The box of sample offsets inside a pixel: a sample of pixel `p` lies in
@@ -93,40 +95,43 @@ impl SamplePattern {
             AaMode::None => (vec![[0.5, 0.5]], 1),
             AaMode::Msaa(n) | AaMode::Ssaa(n) if n <= 16 => (standard(n), n as usize),
             AaMode::Msaa(n) | AaMode::Ssaa(n) => (multi_jittered(n), n as usize),
-            AaMode::Csaa { coverage, stored } => {
-                (stored_first(standard(coverage), stored as usize), stored as usize)
-            }
+            AaMode::Csaa { coverage, stored } => (
+                stored_first(standard(coverage), stored as usize),
+                stored as usize,
+            ),
         };
         let mut span = SampleSpan {
             lo: [f32::INFINITY; 2],
             hi: [f32::NEG_INFINITY; 2],
         };
         for p in &positions {
-            for a in 0..2 {
-                span.lo[a] = span.lo[a].min(p[a]);
-                span.hi[a] = span.hi[a].max(p[a]);
-            }
+            span.lo = [span.lo[0].min(p[0]), span.lo[1].min(p[1])];
+            span.hi = [span.hi[0].max(p[0]), span.hi[1].max(p[1])];
         }
         let distance = |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
-        let nearest_stored = positions
-            .iter()
-            .enumerate()
-            .map(|(c, &p)| {
-                if c < stored || stored == 0 {
-                    return c.min(255) as u8;
-                }
-                (0..stored)
-                    .min_by(|&a, &b| distance(p, positions[a]).total_cmp(&distance(p, positions[b])))
-                    .unwrap_or(0) as u8
-            })
-            .collect();
+        // CSAA: per coverage position, the stored ones nearest first.
+        let nearest: Vec<Vec<u8>> = if stored < positions.len() {
+            positions
+                .iter()
+                .map(|&p| {
+                    let mut order: Vec<u8> = (0..stored as u8).collect();
+                    order.sort_by(|&a, &b| {
+                        let (a, b) = (positions[a as usize], positions[b as usize]);
+                        distance(p, a).total_cmp(&distance(p, b))
+                    });
+                    order
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         SamplePattern {
             mode,
             positions,
             stored,
             shade_per_sample: mode.shades_per_sample(),
             span,
-            nearest_stored,
+            nearest,
         }
     }
 
@@ -188,25 +193,16 @@ fn multi_jittered(n: u32) -> Vec<[f32; 2]> {
     out
 }
 
-/// Reorders `positions` so that the `stored` ones come first: the position
-/// nearest the pixel centre, then repeatedly the one farthest from those chosen.
+/// Reorders `positions` so that the `stored` ones come first: for each
+/// position of the standard `stored`-sample pattern in turn, the nearest one
+/// not yet taken — so `csaa:CxS` stores about where `msaa:S` samples.
 fn stored_first(mut positions: Vec<[f32; 2]>, stored: usize) -> Vec<[f32; 2]> {
     let distance = |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
-    for chosen in 0..stored.min(positions.len()) {
-        let score = |p: [f32; 2]| {
-            if chosen == 0 {
-                -distance(p, [0.5, 0.5])
-            } else {
-                positions[..chosen]
-                    .iter()
-                    .map(|&c| distance(p, c))
-                    .fold(f32::INFINITY, f32::min)
-            }
-        };
-        // The first best keeps the choice deterministic.
+    for (chosen, target) in standard(stored as u32).into_iter().enumerate() {
+        // The first nearest keeps the choice deterministic.
         let mut best = chosen;
         for k in chosen + 1..positions.len() {
-            if score(positions[k]) > score(positions[best]) {
+            if distance(positions[k], target) < distance(positions[best], target) {
                 best = k;
             }
         }
@@ -240,7 +236,10 @@ mod tests {
             assert_eq!(p.stored, mode.stored_samples() as usize, "{mode}");
             assert!(is_n_rooks(&p.positions), "{mode}: {:?}", p.positions);
             for q in &p.positions {
-                assert!((0.0..1.0).contains(&q[0]) && (0.0..1.0).contains(&q[1]), "{mode}");
+                assert!(
+                    (0.0..1.0).contains(&q[0]) && (0.0..1.0).contains(&q[1]),
+                    "{mode}"
+                );
             }
         }
     }

@@ -26,8 +26,8 @@ use serde::{Serialize, Serializer};
 
 pub use crate::binning::SampleOracles;
 
-use crate::aa::{SamplePattern, SampleSpan};
 use crate::aa::resolve::resolve_tile;
+use crate::aa::{SamplePattern, SampleSpan};
 use crate::camera::{View, Viewport};
 use crate::edge::{CurvedTriangle, Triangle3D};
 use crate::framebuffer::{Framebuffer, ResolvedTile, TileBuffer};
@@ -300,7 +300,6 @@ impl Pipeline {
     }
 }
 
-
 /// Renders `view` of `scene` with `pipeline` into `fb`: the pixels, counters
 /// and stage times. The viewport must be one the pipeline
 /// [serves](Pipeline::serves).
@@ -360,19 +359,21 @@ pub(crate) fn run(
             let done: Vec<_> = fb
                 .tile_rects(oracles.frustum)
                 .into_par_iter()
-                .map(|(x0, y0, x1, y1)| {
-                    let tile = TileBuffer::new(x0, y0, x1, y1, pattern);
-                    context.run_tile(tile, |tile| {
-                        let mut t = Traversal::new(scene, view, oracles, tile);
-                        t.run();
-                        (t.counters, t.nodes_visited, t.setups)
-                    })
-                })
+                .map_init(
+                    || None,
+                    |cache, rect| {
+                        context.run_tile(cache, rect, |tile| {
+                            let mut t = Traversal::new(scene, view, oracles, tile);
+                            t.run();
+                            (t.counters, t.nodes_visited, t.setups)
+                        })
+                    },
+                )
                 .collect();
             let mut pass = Pass::default();
             for finished in done {
                 let (counters, nodes, setups) = finished.result;
-                pass.store(fb, finished.map(|_| counters));
+                pass.store(fb, &finished.map(|_| counters));
                 stats.bvh_nodes_visited += nodes;
                 stats.triangle_setups += setups;
             }
@@ -440,17 +441,28 @@ impl<R> Finished<R> {
 }
 
 impl<'a> TileContext<'a> {
-    /// Renders `tile` with `render`, then resolves its samples into pixels.
+    /// Renders the pixels `(x0, y0, x1, y1)` (exclusive ends) with `render`,
+    /// then resolves their samples. The sample buffers are `cache`'s, reused
+    /// from the worker's previous tile when there is one (no fresh pages to
+    /// fault in per tile).
     pub fn run_tile<R>(
         &self,
-        mut tile: TileBuffer<'a>,
+        cache: &mut Option<TileBuffer<'a>>,
+        (x0, y0, x1, y1): (u32, u32, u32, u32),
         render: impl FnOnce(&mut TileBuffer<'a>) -> R,
     ) -> Finished<R> {
         let start = Instant::now();
-        let result = render(&mut tile);
+        let tile = match cache {
+            Some(tile) => {
+                tile.reset(x0, y0, x1, y1);
+                tile
+            }
+            None => cache.insert(TileBuffer::new(x0, y0, x1, y1, self.pattern)),
+        };
+        let result = render(tile);
         let render_s = start.elapsed().as_secs_f64();
         let start = Instant::now();
-        let resolved = resolve_tile(&tile, self.view, &self.shader);
+        let resolved = resolve_tile(tile, self.view, &self.shader);
         Finished {
             resolved,
             result,
@@ -472,7 +484,7 @@ pub(crate) struct Pass {
 
 impl Pass {
     /// Stores a finished tile's pixels and adds up its counters.
-    pub fn store(&mut self, fb: &mut Framebuffer, finished: Finished<RasterCounters>) {
+    pub fn store(&mut self, fb: &mut Framebuffer, finished: &Finished<RasterCounters>) {
         fb.store(&finished.resolved);
         self.counters += finished.result;
         self.histogram += finished.resolved.histogram;
@@ -564,7 +576,10 @@ impl PixelRect {
         let first = |v: f32, hi: f32| (v - hi).ceil().max(0.0);
         let last = |v: f32, lo: f32, n: u32| (v - lo).floor().min(n as f32 - 1.0);
         let (x0, y0) = (first(min_x, span.hi[0]), first(min_y, span.hi[1]));
-        let (x1, y1) = (last(max_x, span.lo[0], width), last(max_y, span.lo[1], height));
+        let (x1, y1) = (
+            last(max_x, span.lo[0], width),
+            last(max_y, span.lo[1], height),
+        );
         // Also rejects NaN bounds.
         if !(x0 <= x1 && y0 <= y1) {
             return None;

@@ -37,7 +37,7 @@ pub(crate) fn render_raycast<T: Coverage + Send + Sync>(
     stats: &mut Stats,
     setup: impl Fn(&[Vec3; 3], &View) -> Option<T> + Sync,
 ) -> Pass {
-    let (view, pattern) = (context.view, context.pattern);
+    let view = context.view;
     // 1. Setup: the 3D edge functions of every drawable triangle for this view.
     let start = Instant::now();
     let setups: Vec<Option<T>> = scene
@@ -57,15 +57,19 @@ pub(crate) fn render_raycast<T: Coverage + Send + Sync>(
     let width = fb.width;
     let done: Vec<_> = bands
         .into_par_iter()
-        .map(|(y0, y1)| {
-            let tile = TileBuffer::new(0, y0, width, y1, pattern);
-            context.run_tile(tile, |tile| cast_band(scene, view, &setups, tile))
-        })
+        .map_init(
+            || None,
+            |cache, (y0, y1)| {
+                context.run_tile(cache, (0, y0, width, y1), |tile| {
+                    cast_band(scene, view, &setups, tile)
+                })
+            },
+        )
         .collect();
     let mut pass = Pass::default();
     for finished in done {
         stats.bvh_nodes_visited += finished.result;
-        pass.store(fb, finished.map(|_| Default::default()));
+        pass.store(fb, &finished.map(|_| Default::default()));
     }
     let (traversal, shading) = pass.split(start.elapsed().as_secs_f64() * 1e3);
     stats.time_ms.traversal = traversal;
@@ -124,7 +128,8 @@ fn cast_band<T: Coverage>(
                     if tile.triangle_id[j] == BACKGROUND {
                         continue;
                     }
-                    let same = (0..s).find(|&t| tile.triangle_id[t * pixels + i] == tile.triangle_id[j]);
+                    let same =
+                        (0..s).find(|&t| tile.triangle_id[t * pixels + i] == tile.triangle_id[j]);
                     tile.masks[j] = match same {
                         Some(t) => tile.masks[t * pixels + i],
                         None => {
@@ -136,6 +141,7 @@ fn cast_band<T: Coverage>(
                         }
                     };
                 }
+                nodes += lost_coverage(scene, view, setups, tile, (x, y));
             }
         }
     }
@@ -166,4 +172,50 @@ fn coverage_mask<T: Coverage>(tri: &T, pattern: &SamplePattern, x: u32, y: u32) 
         }
     }
     mask
+}
+
+/// CSAA, in a pixel where a stored sample is background and another holds a
+/// triangle: which coverage-only positions no stored triangle covers are
+/// covered by some other triangle (the rasterizers' `covered_any`, at the
+/// positions the resolve reads it). One any-hit ray per such position; returns
+/// the BVH nodes visited.
+fn lost_coverage<T: Coverage>(
+    scene: &PreparedScene,
+    view: &View,
+    setups: &[Option<T>],
+    tile: &mut TileBuffer,
+    (x, y): (u32, u32),
+) -> u64 {
+    let pattern = tile.pattern;
+    let (stored, pixels) = (pattern.stored, tile.pixels);
+    let i = tile.index(x, y);
+    let ids = || (0..stored).map(|s| tile.triangle_id[s * pixels + i]);
+    if !ids().any(|id| id == BACKGROUND) || ids().all(|id| id == BACKGROUND) {
+        return 0;
+    }
+    let union = (0..stored).fold(0, |m, s| m | tile.masks[s * pixels + i]);
+    let mut covered = union;
+    let mut nodes = 0;
+    for (c, &[ox, oy]) in pattern.positions.iter().enumerate().skip(stored) {
+        if union & (1 << c) != 0 {
+            continue;
+        }
+        let (xs, ys) = (x as f32 + ox, y as f32 + oy);
+        let Some((origin, direction)) = view.ray(xs, ys) else {
+            continue;
+        };
+        nodes += scene
+            .bvh
+            .walk(origin, direction, |k| match &setups[k as usize] {
+                Some(tri) if tri.covers8([xs; 8], [ys; 8]) & 1 == 1 => {
+                    covered |= 1 << c;
+                    // Found: cull everything left.
+                    f32::NEG_INFINITY
+                }
+                _ if covered & (1 << c) != 0 => f32::NEG_INFINITY,
+                _ => f32::INFINITY,
+            });
+    }
+    tile.covered_any[i] = covered;
+    nodes
 }

@@ -60,7 +60,8 @@ pub(crate) fn setup_2d(
                     continue;
                 };
                 let [x0, y0, x1, y1] = tri.bounds;
-                if let Some(rect) = PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height, span)
+                if let Some(rect) =
+                    PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height, span)
                 {
                     out.push(Placed { tri, rect, id });
                 }

@@ -1,13 +1,13 @@
 //! Screen tiles: triangles are sorted into square tiles of the image by their
 //! bounding boxes (a counting sort), and the tiles are rendered in parallel,
-//! each into its own [`TileBuffer`] and resolved there.
+//! each into its own [`TileBuffer`](crate::framebuffer::TileBuffer) and resolved there.
 
 use rayon::prelude::*;
 
-use super::{PixelRect, Pass, TileContext};
+use super::{Pass, PixelRect, TileContext};
 use crate::binning::{SampleOracles, raster_triangle};
 use crate::edge::Coverage;
-use crate::framebuffer::{Framebuffer, TileBuffer};
+use crate::framebuffer::Framebuffer;
 use crate::stats::RasterCounters;
 
 /// Side of a screen tile in pixels.
@@ -63,23 +63,26 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
     let done: Vec<_> = rects
         .par_iter()
         .enumerate()
-        .map(|(t, &(x0, y0, x1, y1))| {
-            context.run_tile(TileBuffer::new(x0, y0, x1, y1, context.pattern), |tile| {
-                let mut counters = RasterCounters::default();
-                for &k in &members[offsets[t] as usize..offsets[t + 1] as usize] {
-                    let item = &items[k as usize];
-                    // Non-empty: the item was sorted into this tile by its rect.
-                    if let Some(clip) = item.rect.intersect(tile.rect()) {
-                        raster_triangle(tile, &item.tri, item.id, clip, oracles, &mut counters);
+        .map_init(
+            || None,
+            |cache, (t, &rect)| {
+                context.run_tile(cache, rect, |tile| {
+                    let mut counters = RasterCounters::default();
+                    for &k in &members[offsets[t] as usize..offsets[t + 1] as usize] {
+                        let item = &items[k as usize];
+                        // Non-empty: the item was sorted into this tile by its rect.
+                        if let Some(clip) = item.rect.intersect(tile.rect()) {
+                            raster_triangle(tile, &item.tri, item.id, clip, oracles, &mut counters);
+                        }
                     }
-                }
-                counters
-            })
-        })
+                    counters
+                })
+            },
+        )
         .collect();
     let mut pass = Pass::default();
     for finished in done {
-        pass.store(fb, finished);
+        pass.store(fb, &finished);
     }
     pass
 }

@@ -272,11 +272,18 @@ impl Coverage for Triangle3D {
         self.sample_lanes(f32x8::from(x), f32x8::from(y))
     }
 
-    /// Edges and facing, no division.
+    /// Edges, facing, and `w ≥ near` as `volume ≥ near·facing`: no division
+    /// (and no clamp to the vertices' range).
     #[inline(always)]
     fn covers8(&self, x: [f32; 8], y: [f32; 8]) -> u8 {
         let (x, y) = (f32x8::from(x), f32x8::from(y));
-        let inside = self.edges_lanes(x, y) & self.facing_lanes(x, y).simd_gt(f32x8::ZERO);
+        let facing = self.facing_lanes(x, y);
+        let volume = f32x8::splat(self.volume[0])
+            + x * f32x8::splat(self.volume[1])
+            + y * f32x8::splat(self.volume[2]);
+        let inside = self.edges_lanes(x, y)
+            & facing.simd_gt(f32x8::ZERO)
+            & volume.simd_ge(facing * f32x8::splat(self.near));
         inside.to_bitmask() as u8
     }
 

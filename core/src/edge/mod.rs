@@ -87,10 +87,10 @@ pub trait Coverage {
         (mask, depth)
     }
 
-    /// Does the triangle cover each of eight points, depth aside (CSAA's
-    /// coverage-only positions): inside the edges by the tie rule, and in front
-    /// of the eye — [`Coverage::sample`] without its `near` test. The default
-    /// keeps that test (for edge functions whose coverage needs no depth).
+    /// Does the triangle cover each of eight points (CSAA's coverage-only
+    /// positions), without computing depth where that can be avoided: the
+    /// edges with the tie rule, in front of the eye and not nearer than `near`.
+    /// Every algorithm decides coverage-only positions with this one function.
     #[inline(always)]
     fn covers8(&self, x: [f32; 8], y: [f32; 8]) -> u8 {
         self.sample_points8(x, y).0

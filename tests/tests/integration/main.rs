@@ -1,5 +1,6 @@
 //! One integration-test binary, a module per topic.
 
+mod aa;
 mod agreement;
 mod loaders;
 mod oracles;
