@@ -163,7 +163,9 @@ fn panel_svg(svg: &mut String, x0: f64, scene: &str, points: &[&AaPoint], algori
             path.join(" ")
         );
     }
-    // The points, coloured by algorithm and labelled by mode.
+    // The points, coloured by algorithm and labelled by mode where the label
+    // finds room (every point names itself in its tooltip).
+    let mut placed: Vec<[f64; 4]> = Vec::new();
     for (i, p) in points.iter().enumerate() {
         let color = algorithm_color(algorithms, &p.algorithm);
         let (x, y) = (sx(p.median_ms), sy(p.flip_mean));
@@ -174,15 +176,36 @@ fn panel_svg(svg: &mut String, x0: f64, scene: &str, points: &[&AaPoint], algori
         };
         let _ = writeln!(
             svg,
-            r#"<circle cx="{x:.1}" cy="{y:.1}" r="4" fill="{color}"{ring}><title>{} {}: {:.2} ms, FLIP {:.5}</title></circle><text x="{:.1}" y="{:.1}" fill="{color}">{}</text>"#,
+            r#"<circle cx="{x:.1}" cy="{y:.1}" r="4" fill="{color}"{ring}><title>{} {}: {:.2} ms, FLIP {:.5}</title></circle>"#,
             escape(&p.algorithm),
             escape(&p.aa),
             p.median_ms,
             p.flip_mean,
-            x + 6.0,
-            y - 4.0,
-            escape(&p.aa)
         );
+        let width = 6.5 * p.aa.len() as f64;
+        let spot = [
+            (6.0, -4.0),
+            (6.0, 12.0),
+            (-6.0 - width, -4.0),
+            (-6.0 - width, 12.0),
+        ]
+        .into_iter()
+        .map(|(dx, dy)| [x + dx, y + dy - 10.0, x + dx + width, y + dy])
+        .find(|b| {
+            !placed
+                .iter()
+                .any(|o| b[0] < o[2] && o[0] < b[2] && b[1] < o[3] && o[1] < b[3])
+        });
+        if let Some(b) = spot {
+            placed.push(b);
+            let _ = writeln!(
+                svg,
+                r#"<text x="{:.1}" y="{:.1}" fill="{color}">{}</text>"#,
+                b[0],
+                b[3],
+                escape(&p.aa)
+            );
+        }
     }
     // Legend.
     let mut lx = x0 + MARGIN_L;
