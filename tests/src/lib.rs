@@ -253,6 +253,26 @@ pub fn explain_2d_3d(
     report
 }
 
+/// A camera at the origin looking down −z with a 90° field of view: at 8×8 pixels
+/// the sample generator is exact in binary (`d0 = (−1, 1, −1)`, `dx = (¼, 0, 0)`,
+/// `dy = (0, −¼, 0)`), so pixel point `(x, y)` is world point `(−1 + x/4, 1 − y/4, −1)`
+/// and edges through pixel centres evaluate to exactly zero.
+pub fn exact_camera() -> Camera {
+    Camera {
+        name: "exact".into(),
+        eye: glam::Vec3::ZERO,
+        target: glam::Vec3::NEG_Z,
+        up: glam::Vec3::Y,
+        viewport: continuum::Viewport::Perspective { fov_y_deg: 90.0 },
+        near: Some(0.01),
+    }
+}
+
+/// World point of pixel point `(x, y)` under [`exact_camera`] at 8×8 pixels.
+pub fn pixel_point(x: f32, y: f32) -> glam::Vec3 {
+    glam::Vec3::new(-1.0 + x / 4.0, 1.0 - y / 4.0, -1.0)
+}
+
 /// A scene made in code: `triangles` over `positions`, one default material, one camera.
 pub fn scene_from_triangles(
     positions: Vec<glam::Vec3>,

@@ -60,15 +60,7 @@ pub trait Coverage {
     /// must round alike: no fused multiply-add, the same operation order).
     #[inline(always)]
     fn sample8(&self, x0: f32, y: f32) -> (u8, [f32; 8]) {
-        let mut mask = 0;
-        let mut depth = [0.0; 8];
-        for (k, d) in depth.iter_mut().enumerate() {
-            if let Some(w) = self.sample(x0 + k as f32, y) {
-                mask |= 1 << k;
-                *d = w;
-            }
-        }
-        (mask, depth)
+        lanes8(|k| self.sample(x0 + k as f32, y))
     }
 
     /// Coverage and depth of eight samples at any points `(x[k], y[k])` (the
@@ -76,15 +68,7 @@ pub trait Coverage {
     /// [`Coverage::sample`] per lane.
     #[inline(always)]
     fn sample_points8(&self, x: [f32; 8], y: [f32; 8]) -> (u8, [f32; 8]) {
-        let mut mask = 0;
-        let mut depth = [0.0; 8];
-        for (k, d) in depth.iter_mut().enumerate() {
-            if let Some(w) = self.sample(x[k], y[k]) {
-                mask |= 1 << k;
-                *d = w;
-            }
-        }
-        (mask, depth)
+        lanes8(|k| self.sample(x[k], y[k]))
     }
 
     /// Does the triangle cover each of eight points (CSAA's coverage-only
@@ -99,15 +83,7 @@ pub trait Coverage {
     /// [`Coverage::depth_inside`] for eight points of a block found inside.
     #[inline(always)]
     fn depth_inside8(&self, x: [f32; 8], y: [f32; 8]) -> (u8, [f32; 8]) {
-        let mut mask = 0;
-        let mut depth = [0.0; 8];
-        for (k, d) in depth.iter_mut().enumerate() {
-            if let Some(w) = self.depth_inside(x[k], y[k]) {
-                mask |= 1 << k;
-                *d = w;
-            }
-        }
-        (mask, depth)
+        lanes8(|k| self.depth_inside(x[k], y[k]))
     }
 
     /// Coverage of the `n` samples `(x0 + k, y)`, `k < n`: calls `hit(k, w)` for
@@ -143,6 +119,21 @@ pub trait Coverage {
 
     /// No sample of the triangle has a smaller depth than this.
     fn min_depth(&self) -> f32;
+}
+
+/// Eight scalar decisions as one lane mask and their depths (the default of
+/// the 8-sample methods).
+#[inline(always)]
+fn lanes8(sample: impl Fn(usize) -> Option<f32>) -> (u8, [f32; 8]) {
+    let mut mask = 0;
+    let mut depth = [0.0; 8];
+    for (k, d) in depth.iter_mut().enumerate() {
+        if let Some(w) = sample(k) {
+            mask |= 1 << k;
+            *d = w;
+        }
+    }
+    (mask, depth)
 }
 
 /// Edge functions linear in the image point (planar viewports): the parts from

@@ -3,25 +3,12 @@
 //! sample, algorithms agree per sample, and shading runs as often as each mode
 //! promises.
 
-use continuum::{AaMode, AlgorithmId, Camera, Family, Viewport};
-use continuum_tests::{prepared, render_aa, scene_from_triangles};
+use continuum::{AaMode, AlgorithmId, Family, Viewport};
+use continuum_tests::{exact_camera, pixel_point, prepared, render_aa, scene_from_triangles};
 use glam::{DVec2, Vec3};
 
-/// The camera of the tie-rule tests: at 8×8 pixels, pixel point `(x, y)` is
-/// world point `(−1 + x/4, 1 − y/4, −1)` exactly.
-fn exact_camera() -> Camera {
-    Camera {
-        name: "exact".into(),
-        eye: Vec3::ZERO,
-        target: Vec3::NEG_Z,
-        up: Vec3::Y,
-        viewport: Viewport::Perspective { fov_y_deg: 90.0 },
-        near: Some(0.01),
-    }
-}
-
 fn world(p: DVec2) -> Vec3 {
-    Vec3::new(-1.0 + p.x as f32 / 4.0, 1.0 - p.y as f32 / 4.0, -1.0)
+    pixel_point(p.x as f32, p.y as f32)
 }
 
 /// Area of the unit pixel `[x, x+1] × [y, y+1]` where `n·(p − c) ≥ t`

@@ -1,28 +1,9 @@
 //! The top-left rule: pixel centres exactly on edges and vertices go to exactly
 //! one triangle, the Direct3D way, in every algorithm.
 
-use continuum::{AlgorithmId, BACKGROUND, Camera};
-use continuum_tests::{render_with, scene_from_triangles};
+use continuum::{AlgorithmId, BACKGROUND};
+use continuum_tests::{exact_camera, pixel_point, render_with, scene_from_triangles};
 use glam::Vec3;
-
-/// A camera at the origin looking down −z with a 90° field of view: at 8×8 pixels
-/// the sample generator is exact in binary (`d0 = (−1, 1, −1)`, `dx = (¼, 0, 0)`,
-/// `dy = (0, −¼, 0)`), so pixel point `(x, y)` is world point `(−1 + x/4, 1 − y/4, −1)`
-/// and edges through pixel centres evaluate to exactly zero.
-fn exact_camera() -> Camera {
-    Camera {
-        name: "exact".into(),
-        eye: Vec3::ZERO,
-        target: Vec3::NEG_Z,
-        up: Vec3::Y,
-        viewport: continuum::Viewport::Perspective { fov_y_deg: 90.0 },
-        near: Some(0.01),
-    }
-}
-
-fn pixel_point(x: f32, y: f32) -> Vec3 {
-    Vec3::new(-1.0 + x / 4.0, 1.0 - y / 4.0, -1.0)
-}
 
 /// Direct3D's worked example: a 5×5 square from (0.5, 0.5) to (5.5, 5.5) split
 /// along its diagonal covers 15 + 10 pixels, none twice.
