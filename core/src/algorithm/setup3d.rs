@@ -48,12 +48,20 @@ fn setup_visible<T: Send>(
     span: SampleSpan,
     setup: impl Fn(&[Vec3; 3], &View) -> Option<T> + Sync,
 ) -> Vec<Placed<T>> {
+    // Planar views: every vertex projected once, not once per triangle using it.
+    let projected = view
+        .sphere
+        .is_none()
+        .then(|| VertexPoints::new(scene, view));
     scene
         .drawable
         .par_iter()
         .filter_map(|&id| {
             let p = &scene.triangles[id as usize];
-            let rect = screen_rect(p, view, span)?;
+            let rect = match &projected {
+                Some(points) => points.rect(scene, id, view, span),
+                None => screen_rect(p, view, span),
+            }?;
             Some(Placed {
                 tri: setup(p, view)?,
                 rect,
@@ -83,42 +91,116 @@ pub(crate) fn screen_rect(p: &[Vec3; 3], view: &View, span: SampleSpan) -> Optio
             span,
         );
     }
-    let near_bound = view.near * (1.0 - 1.0 / 1024.0);
+    let near_bound = near_bound(view);
     let cam = [
         view.to_camera(p[0]),
         view.to_camera(p[1]),
         view.to_camera(p[2]),
     ];
-    let mut min = [f32::INFINITY; 2];
-    let mut max = [f32::NEG_INFINITY; 2];
-    let mut grow = |c: Vec3| {
-        let (x, y) = view.project(c);
-        min = [min[0].min(x), min[1].min(y)];
-        max = [max[0].max(x), max[1].max(y)];
-    };
+    let mut image_box = ImageBox::EMPTY;
     if cam.iter().all(|c| c.z >= near_bound) {
-        cam.into_iter().for_each(&mut grow);
+        cam.into_iter()
+            .for_each(|c| image_box.grow(view.project(c)));
     } else {
         let plane = ClipPlane {
             k: Vec3::Z,
             offset: near_bound,
         };
         let poly = clip_triangle(cam, &[plane])?;
-        poly.as_slice().iter().copied().for_each(&mut grow);
+        for &c in poly.as_slice() {
+            image_box.grow(view.project(c));
+        }
     }
-    let magnitude = min[0]
-        .abs()
-        .max(min[1].abs())
-        .max(max[0].abs())
-        .max(max[1].abs());
-    let pad = 1.0 / 16.0 + magnitude / 65536.0;
-    PixelRect::from_bounds(
-        min[0] - pad,
-        min[1] - pad,
-        max[0] + pad,
-        max[1] + pad,
-        view.width,
-        view.height,
-        span,
-    )
+    image_box.pixels(view, span)
+}
+
+/// Triangles reaching nearer than this are clipped for their screen box:
+/// slightly less than `near`, so rounding never cuts off a sample at `near`.
+fn near_bound(view: &View) -> f32 {
+    view.near * (1.0 - 1.0 / 1024.0)
+}
+
+/// The image points of every mesh vertex for one planar view (`None` for
+/// vertices nearer than [`near_bound`]): the same values [`screen_rect`]
+/// computes, once per vertex.
+struct VertexPoints {
+    points: Vec<Option<(f32, f32)>>,
+}
+
+impl VertexPoints {
+    fn new(scene: &PreparedScene, view: &View) -> VertexPoints {
+        let near_bound = near_bound(view);
+        let points = scene
+            .scene
+            .mesh
+            .positions
+            .par_iter()
+            .map(|&p| {
+                let c = view.to_camera(p);
+                (c.z >= near_bound).then(|| view.project(c))
+            })
+            .collect();
+        VertexPoints { points }
+    }
+
+    /// [`screen_rect`] of triangle `id` (`scene.triangles[id]` are its mesh
+    /// vertices' positions, so the points are the ones it would compute).
+    fn rect(
+        &self,
+        scene: &PreparedScene,
+        id: u32,
+        view: &View,
+        span: SampleSpan,
+    ) -> Option<PixelRect> {
+        let mut image_box = ImageBox::EMPTY;
+        for v in scene.scene.mesh.triangles[id as usize] {
+            match self.points[v as usize] {
+                Some(point) => image_box.grow(point),
+                // Reaches nearer than near: clipped.
+                None => return screen_rect(&scene.triangles[id as usize], view, span),
+            }
+        }
+        image_box.pixels(view, span)
+    }
+}
+
+/// A box of image points.
+#[derive(Clone, Copy, Debug)]
+struct ImageBox {
+    min: [f32; 2],
+    max: [f32; 2],
+}
+
+impl ImageBox {
+    const EMPTY: ImageBox = ImageBox {
+        min: [f32::INFINITY; 2],
+        max: [f32::NEG_INFINITY; 2],
+    };
+
+    #[inline]
+    fn grow(&mut self, (x, y): (f32, f32)) {
+        self.min = [self.min[0].min(x), self.min[1].min(y)];
+        self.max = [self.max[0].max(x), self.max[1].max(y)];
+    }
+
+    /// The pixels with a sample in the box, padded by 1/16 pixel plus a
+    /// relative 2⁻¹⁶ against rounding in the projection.
+    fn pixels(self, view: &View, span: SampleSpan) -> Option<PixelRect> {
+        let (min, max) = (self.min, self.max);
+        let magnitude = min[0]
+            .abs()
+            .max(min[1].abs())
+            .max(max[0].abs())
+            .max(max[1].abs());
+        let pad = 1.0 / 16.0 + magnitude / 65536.0;
+        PixelRect::from_bounds(
+            min[0] - pad,
+            min[1] - pad,
+            max[0] + pad,
+            max[1] + pad,
+            view.width,
+            view.height,
+            span,
+        )
+    }
 }
