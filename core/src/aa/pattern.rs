@@ -145,9 +145,37 @@ impl SamplePattern {
         self.positions.len() > self.stored
     }
 
-    /// The bit mask of every coverage position.
-    pub fn all_coverage(&self) -> u32 {
-        u32::MAX >> (32 - self.positions.len())
+    /// `k` when the positions are stratified over a k×k grid (one in each
+    /// cell): the 2×2 rotated grid of 4 and the multi-jittered 64 and 256.
+    pub fn stratified_grid(&self) -> Option<usize> {
+        let n = self.positions.len();
+        let k = (n as f64).sqrt().round() as usize;
+        if k * k != n || k < 2 {
+            return None;
+        }
+        let mut seen = vec![false; n];
+        for q in &self.positions {
+            let cell = (q[1] * k as f32) as usize * k + (q[0] * k as f32) as usize;
+            if cell >= n || std::mem::replace(&mut seen[cell], true) {
+                return None;
+            }
+        }
+        Some(k)
+    }
+
+    /// How far the covered fraction of a pixel crossed by one straight edge can
+    /// be from the covered area. Axis-aligned edges: 1/N (every pattern is
+    /// N-rooks: each of the N columns and rows holds one position). Any other
+    /// edge: (2k − 1)/N for patterns stratified over a k×k grid (the edge
+    /// crosses at most 2k − 1 cells, each off by at most its area 1/N); no
+    /// bound below 1 otherwise.
+    pub fn edge_error_bound(&self, axis_aligned: bool) -> f64 {
+        let n = self.positions.len() as f64;
+        match (axis_aligned, self.stratified_grid()) {
+            (true, _) => 1.0 / n,
+            (false, Some(k)) => (2 * k - 1) as f64 / n,
+            (false, None) => 1.0,
+        }
     }
 }
 

@@ -43,7 +43,8 @@ fn analytic_area(pixel: DVec2, n: DVec2, c: DVec2, t: f64) -> f64 {
 /// A straight edge across pixel (3, 3) at many angles and offsets: the covered
 /// count is exactly the number of pattern positions on the inner side (every
 /// sample goes through the edge function), and the covered fraction is within
-/// 1/N of the analytic area for axis-aligned edges (N-rooks patterns). The mean
+/// the pattern's documented bound of the analytic area (1/N for axis-aligned
+/// edges; (2k − 1)/N for k×k stratified patterns at any angle). The mean
 /// absolute error per mode is printed (`--nocapture`).
 #[test]
 fn edge_coverage_matches_the_pattern_and_the_analytic_area() {
@@ -90,12 +91,11 @@ fn edge_coverage_matches_the_pattern_and_the_analytic_area() {
                 assert_eq!(covered, expected, "{mode}: angle step {step}, offset {t}");
                 let fraction = f64::from(covered) / pattern.positions.len() as f64;
                 let error = (fraction - area).abs();
-                if axis_aligned {
-                    assert!(
-                        error <= 1.0 / pattern.positions.len() as f64 + 1e-12,
-                        "{mode}: axis-aligned edge at offset {t}: {fraction} vs area {area}"
-                    );
-                }
+                let bound = pattern.edge_error_bound(axis_aligned);
+                assert!(
+                    error <= bound + 1e-12,
+                    "{mode}: edge at angle step {step}, offset {t}: {fraction} vs area {area}, bound {bound}"
+                );
                 errors[m].0 += error;
                 errors[m].1 += 1;
                 errors[m].2 = errors[m].2.max(error);
@@ -112,6 +112,21 @@ fn edge_coverage_matches_the_pattern_and_the_analytic_area() {
             max
         );
     }
+    // The stratified patterns are the ones the bound says.
+    let grids: Vec<Option<usize>> = modes
+        .iter()
+        .map(|m| m.pattern().stratified_grid())
+        .collect();
+    let expected: Vec<Option<usize>> = modes
+        .iter()
+        .map(|m| match m {
+            AaMode::Ssaa(4) | AaMode::Msaa(4) => Some(2),
+            AaMode::Ssaa(64) => Some(8),
+            AaMode::Ssaa(256) => Some(16),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(grids, expected);
     // More samples, closer to the area: the mean error falls with N.
     let mean = |m: AaMode| {
         let k = modes.iter().position(|&x| x == m).unwrap_or(0);
