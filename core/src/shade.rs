@@ -116,7 +116,7 @@ fn srgb_table() -> &'static SrgbTable {
     })
 }
 
-/// Linear [0, 1] → sRGB byte, exactly [`encode_srgb_formula`] (tested on
+/// Linear [0, 1] → sRGB byte, exactly the transfer function (tested on
 /// every threshold and millions of values) without its `powf`: the bucket's
 /// first byte, then up past the thresholds `v` reaches (at most a step or two).
 #[inline]
