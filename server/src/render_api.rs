@@ -95,6 +95,17 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
         )
         .into());
     }
+    let samples = u64::from(size.0) * u64::from(size.1) * u64::from(samples_per_pixel);
+    if samples > state.limits.max_samples {
+        return Err(FieldError::new(
+            "aa",
+            format!(
+                "{}x{} with {aa} is {samples} samples, over the limit of {}; use a smaller size or mode",
+                size.0, size.1, state.limits.max_samples
+            ),
+        )
+        .into());
+    }
     if let Some(bad) = body
         .outputs
         .iter()

@@ -26,6 +26,9 @@ pub struct ServeArgs {
     /// Most samples per pixel an anti-aliasing mode may take [default: 256].
     #[arg(long)]
     pub max_samples_per_pixel: Option<u32>,
+    /// Most samples in one render, pixels × samples per pixel [default: 65536000].
+    #[arg(long)]
+    pub max_samples: Option<u64>,
     /// Renders that may wait for a slot; more are answered 503 [default: 4 × cores].
     #[arg(long)]
     pub max_queued: Option<usize>,
@@ -65,6 +68,10 @@ impl ServeArgs {
         if let Some(v) = self.max_samples_per_pixel {
             positive("max-samples-per-pixel", v > 0)?;
             l.max_samples_per_pixel = v;
+        }
+        if let Some(v) = self.max_samples {
+            positive("max-samples", v > 0)?;
+            l.max_samples = v;
         }
         if let Some(v) = self.max_queued {
             l.max_queued_renders = v;

@@ -19,6 +19,9 @@ pub struct Limits {
     pub max_pixels: u64,
     /// Most samples per pixel a request may ask for (anti-aliasing modes).
     pub max_samples_per_pixel: u32,
+    /// Most samples in one render (pixels × samples per pixel): what bounds a
+    /// render's time once anti-aliasing multiplies its pixels.
+    pub max_samples: u64,
     /// Renders running at once.
     pub max_concurrent_renders: usize,
     /// Renders that may wait for a slot; more get 503 with `Retry-After`.
@@ -38,6 +41,7 @@ impl Default for Limits {
         Limits {
             max_pixels: 2560 * 1600,
             max_samples_per_pixel: 256,
+            max_samples: 2560 * 1600 * 16,
             max_concurrent_renders: std::thread::available_parallelism().map_or(2, |n| n.get()),
             max_queued_renders: 4 * std::thread::available_parallelism().map_or(2, |n| n.get()),
             render_timeout: Duration::from_secs(60),

@@ -266,6 +266,18 @@ fn render_json_and_png() {
     );
     assert_eq!(status, StatusCode::BAD_REQUEST, "{doc}");
     assert_eq!(doc["field"], "aa");
+    // Within samples per pixel but over the samples of one render.
+    let (status, doc) = post(
+        &s,
+        "/api/render",
+        r#"{ "scene": "box", "algorithm": "3dr-bin", "size": "2560x1600", "aa": "ssaa:64" }"#,
+    );
+    assert_eq!(status, StatusCode::BAD_REQUEST, "{doc}");
+    assert_eq!(doc["field"], "aa");
+    assert!(
+        doc["error"].as_str().is_some_and(|e| e.contains("samples")),
+        "{doc}"
+    );
     let (status, png) = get(
         &s,
         "/api/render.png?scene=box&algorithm=2dr-brute&size=32x24&aa=msaa:4",
