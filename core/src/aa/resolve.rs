@@ -144,14 +144,8 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
                     let first = slot_color[0];
                     slot_color[1..stored].fill(first);
                 }
-                mixed_color(
-                    tile,
-                    view,
-                    i,
-                    (x, y),
-                    &mut slot_color,
-                    [background, outside],
-                ) / pattern.coverage() as f32
+                mixed_color(tile, view, i, (x, y), &slot_color, [background, outside])
+                    / pattern.coverage() as f32
             });
         }
     }
@@ -159,13 +153,13 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
 }
 
 /// The sum of what every coverage sample of pixel `i` (at `(x, y)`) sees, given
-/// the colours of its stored samples (`slot_color`, overwritten for CSAA).
+/// the colours of its stored samples (`slot_color`).
 fn mixed_color(
     tile: &TileBuffer,
     view: &View,
     i: usize,
     (x, y): (u32, u32),
-    slot_color: &mut [Vec3; MAX_STORED],
+    slot_color: &[Vec3; MAX_STORED],
     [background, outside]: [Vec3; 2],
 ) -> Vec3 {
     let pattern = tile.pattern;
