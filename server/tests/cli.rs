@@ -260,6 +260,12 @@ fn bad_arguments_exit_2_naming_the_argument() {
     }
 }
 
+/// The `results.json` a compare run wrote into `dir`.
+fn results_json(dir: &std::path::Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(dir.join("results.json")).expect("results.json"))
+        .expect("JSON")
+}
+
 #[test]
 fn compare_writes_results_with_the_documented_keys() {
     let dir = out_dir("compare");
@@ -283,9 +289,7 @@ fn compare_writes_results_with_the_documented_keys() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let doc: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("results.json")).expect("results.json"))
-            .expect("JSON");
+    let doc = results_json(&dir);
     assert!(doc["machine"].is_object() && doc["command"].is_string());
     let rows = doc["rows"].as_array().expect("rows");
     assert_eq!(rows.len(), 10);
@@ -341,9 +345,7 @@ fn compare_measures_anti_aliasing_against_the_reference() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let doc: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("results.json")).expect("results.json"))
-            .expect("JSON");
+    let doc = results_json(&dir);
     let rows = doc["rows"].as_array().expect("rows");
     // The peer renders one sample per pixel: measured for `none` only.
     assert_eq!(rows.len(), 2 * 3 + 1);
@@ -419,9 +421,7 @@ fn compare_runs_the_embree_peers() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let doc: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("results.json")).expect("results.json"))
-            .expect("JSON");
+    let doc = results_json(&dir);
     for row in &doc["rows"].as_array().expect("rows")[1..] {
         // Embree is not watertight, but on a closed sphere it should miss very little.
         let differing = row["pixels_differing_from_3dr_brute"]

@@ -122,30 +122,43 @@ fn cast_band<T: Coverage>(
                 }
             }
             if pattern.has_coverage_only() {
-                // The coverage mask of each stored triangle over the pixel.
-                for s in 0..stored {
-                    let j = s * pixels + i;
-                    if tile.triangle_id[j] == BACKGROUND {
-                        continue;
-                    }
-                    let same =
-                        (0..s).find(|&t| tile.triangle_id[t * pixels + i] == tile.triangle_id[j]);
-                    tile.masks[j] = match same {
-                        Some(t) => tile.masks[t * pixels + i],
-                        None => {
-                            let Some(tri) = &setups[slots[s] as usize] else {
-                                continue;
-                            };
-                            tile.edge_evals[i] += pattern.coverage() as u32;
-                            coverage_mask(tri, pattern, x, y)
-                        }
-                    };
-                }
+                stored_masks(setups, &slots, tile, (x, y));
                 nodes += lost_coverage(scene, view, setups, tile, (x, y));
             }
         }
     }
     nodes
+}
+
+/// CSAA: the coverage mask of each triangle the stored rays of pixel `(x, y)`
+/// found (`slots[s]`: the BVH slot of stored sample `s`'s triangle), computed
+/// once per triangle.
+fn stored_masks<T: Coverage>(
+    setups: &[Option<T>],
+    slots: &[u32; 8],
+    tile: &mut TileBuffer,
+    (x, y): (u32, u32),
+) {
+    let pattern = tile.pattern;
+    let (i, pixels) = (tile.index(x, y), tile.pixels);
+    let id_at = |tile: &TileBuffer, s: usize| tile.triangle_id[s * pixels + i];
+    for s in 0..pattern.stored {
+        let id = id_at(tile, s);
+        if id == BACKGROUND {
+            continue;
+        }
+        let mask = match (0..s).find(|&t| id_at(tile, t) == id) {
+            Some(t) => tile.masks[t * pixels + i],
+            None => {
+                let Some(tri) = &setups[slots[s] as usize] else {
+                    continue;
+                };
+                tile.edge_evals[i] += pattern.coverage() as u32;
+                coverage_mask(tri, pattern, x, y)
+            }
+        };
+        tile.masks[s * pixels + i] = mask;
+    }
 }
 
 /// The coverage mask of `tri` over pixel `(x, y)` as the rasterizers compute it:
