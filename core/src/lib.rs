@@ -10,7 +10,7 @@
 //! let scene = continuum::scene::load_path("scenes/bunny.toml".as_ref()).unwrap();
 //! let prepared = PreparedScene::new(scene);
 //! let camera = prepared.scene.first_camera();
-//! let out = render(&prepared, &RenderRequest { algorithm: AlgorithmId::ThreeDBrute, oracles: None, camera, width: 640, height: 480, aa: Default::default() }).unwrap();
+//! let out = render(&prepared, &RenderRequest { algorithm: AlgorithmId::ThreeDBrute, oracles: None, camera, width: 640, height: 480, aa: Default::default(), precision: Default::default() }).unwrap();
 //! println!("{}", out.hashes.triangle_id);
 //! ```
 
@@ -25,6 +25,7 @@ pub mod framebuffer;
 pub mod maps;
 pub mod metrics;
 pub mod peer;
+pub mod precision;
 pub mod prepared;
 pub mod render;
 pub mod request;
@@ -38,6 +39,7 @@ pub use aa::AaMode;
 pub use algorithm::{AlgorithmId, Family, Pipeline};
 pub use camera::{Camera, View};
 pub use framebuffer::{BACKGROUND, Framebuffer};
+pub use precision::Precision;
 pub use prepared::PreparedScene;
 pub use render::{RenderError, RenderOutput, RenderRequest, render};
 pub use scene::{Scene, SceneError};

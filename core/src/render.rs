@@ -9,6 +9,7 @@ use crate::aa::AaMode;
 use crate::algorithm::{self, AlgorithmId};
 use crate::camera::{Camera, CameraError, View, Viewport};
 use crate::framebuffer::Framebuffer;
+use crate::precision::Precision;
 use crate::prepared::PreparedScene;
 use crate::request::FieldError;
 use crate::stats::{Hashes, Stats};
@@ -28,6 +29,8 @@ pub struct RenderRequest {
     pub height: u32,
     /// Anti-aliasing mode (sample pattern and shading rate).
     pub aa: AaMode,
+    /// The number representation coverage is decided in.
+    pub precision: Precision,
 }
 
 /// A request that cannot be rendered, with the field at fault.
@@ -64,6 +67,7 @@ pub struct RenderOutput {
     pub viewport: String,
     /// The anti-aliasing mode in the CLI's words.
     pub aa: String,
+    pub precision: Precision,
     pub view: View,
     pub framebuffer: Framebuffer,
     pub stats: Stats,
@@ -78,6 +82,7 @@ pub struct RenderSummary<'a> {
     pub camera: &'a str,
     pub viewport: &'a str,
     pub aa: &'a str,
+    pub precision: Precision,
     pub width: u32,
     pub height: u32,
     pub stats: &'a Stats,
@@ -92,6 +97,7 @@ impl RenderOutput {
             camera,
             viewport: &self.viewport,
             aa: &self.aa,
+            precision: self.precision,
             width: self.view.width,
             height: self.view.height,
             stats: &self.stats,
@@ -133,6 +139,9 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
     if !pipeline.serves(&view.viewport) {
         return Err(view.viewport.unsupported(request.algorithm).into());
     }
+    if !request.precision.serves(request.algorithm.family()) {
+        return Err(request.precision.unsupported(request.algorithm).into());
+    }
     if pipeline.samples().is_some_and(|s| s.incremental) && view.viewport != Viewport::Parabolic {
         return Err(FieldError::new(
             "oracles",
@@ -153,7 +162,15 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
         )
         .into());
     }
-    algorithm::run(pipeline, scene, &view, &pattern, &mut fb, &mut stats);
+    algorithm::run(
+        pipeline,
+        request.precision,
+        scene,
+        &view,
+        &pattern,
+        &mut fb,
+        &mut stats,
+    );
 
     stats.edge_evaluations = fb.edge_evals.iter().map(|&e| u64::from(e)).sum();
     stats.max_edge_evals_per_pixel = fb.edge_evals.iter().copied().max().unwrap_or(0);
@@ -170,6 +187,7 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
         algorithm: request.algorithm,
         viewport: request.camera.viewport.to_string(),
         aa: request.aa.to_string(),
+        precision: request.precision,
         view,
         framebuffer: fb,
         stats,

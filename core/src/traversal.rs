@@ -19,7 +19,7 @@ use crate::algorithm::setup3d::screen_rect;
 use crate::binning::{SampleOracles, raster_triangle};
 use crate::bvh::{SlabRay, padded};
 use crate::camera::View;
-use crate::edge::Triangle3D;
+use crate::edge::Coverage;
 use crate::framebuffer::TileBuffer;
 use crate::prepared::PreparedScene;
 use crate::stats::RasterCounters;
@@ -39,12 +39,16 @@ pub struct TraversalOracles {
     pub samples: SampleOracles,
 }
 
+/// Sets up a leaf triangle's edge functions for a view (f32 or f64).
+pub(crate) type Setup<T> = fn(&[Vec3; 3], &View) -> Option<T>;
+
 /// Per-frustum traversal state and counters.
-pub(crate) struct Traversal<'a, 't> {
+pub(crate) struct Traversal<'a, 't, T> {
     pub scene: &'a PreparedScene,
     pub view: &'a View,
     pub oracles: TraversalOracles,
     pub tile: &'t mut TileBuffer<'a>,
+    pub setup: Setup<T>,
     pub counters: RasterCounters,
     pub nodes_visited: u64,
     pub setups: u64,
@@ -65,19 +69,22 @@ struct NodeBox {
     min_w: f32,
 }
 
-impl<'a, 't> Traversal<'a, 't> {
-    /// A traversal of the frustum over `tile`'s pixels.
+impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
+    /// A traversal of the frustum over `tile`'s pixels, leaf triangles set up
+    /// by `setup`.
     pub fn new(
         scene: &'a PreparedScene,
         view: &'a View,
         oracles: TraversalOracles,
         tile: &'t mut TileBuffer<'a>,
+        setup: Setup<T>,
     ) -> Self {
         Traversal {
             scene,
             view,
             oracles,
             tile,
+            setup,
             counters: RasterCounters::default(),
             nodes_visited: 0,
             setups: 0,
@@ -276,7 +283,7 @@ impl<'a, 't> Traversal<'a, 't> {
                 continue;
             };
             self.setups += 1;
-            let Some(tri) = Triangle3D::setup(p, self.view) else {
+            let Some(tri) = (self.setup)(p, self.view) else {
                 continue;
             };
             raster_triangle(

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use continuum::request::{parse_aa, parse_algorithm, parse_size, parse_viewport};
-use continuum::{AlgorithmId, PreparedScene, RenderRequest, maps, render};
+use continuum::{AlgorithmId, Precision, PreparedScene, RenderRequest, maps, render};
 
 use crate::{CliError, scenes_dir};
 
@@ -32,6 +32,10 @@ pub struct RenderArgs {
     /// Anti-aliasing mode: none, ssaa:N (4|16|64|256), msaa:N (2|4|8|16), csaa:CxS (e.g. 16x4).
     #[arg(long, default_value = "none")]
     aa: String,
+    /// Precision of coverage decisions: f32, f64 (3D family) or fixed (2D
+    /// family: vertices snapped to 1/256 pixel, exact integer edge functions).
+    #[arg(long, default_value = "f32", value_parser = |s: &str| Precision::parse(s).map_err(|e| e.message))]
+    precision: Precision,
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "640x480", value_parser = |s: &str| parse_size(s).map_err(|e| e.message))]
     size: (u32, u32),
@@ -76,6 +80,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         width,
         height,
         aa,
+        precision: args.precision,
     };
     let out = render(&prepared, &request).map_err(|e| CliError::Usage(format!("--{e}")))?;
 

@@ -15,7 +15,9 @@ use clap::Args;
 use continuum::metrics::{self, ImageError};
 use continuum::peer::{PeerId, run_peer};
 use continuum::request::{parse_algorithm, parse_size};
-use continuum::{AaMode, AlgorithmId, Framebuffer, PreparedScene, RenderRequest, View, render};
+use continuum::{
+    AaMode, AlgorithmId, Framebuffer, Precision, PreparedScene, RenderRequest, View, render,
+};
 use serde::Serialize;
 use serde_json::{Value, json};
 
@@ -48,6 +50,11 @@ pub struct CompareArgs {
     /// [default: none, without a reference].
     #[arg(long, value_delimiter = ',', value_parser = |s: &str| continuum::AaMode::parse(s).map_err(|e| e.message))]
     aa: Vec<AaMode>,
+    /// Precisions, comma-separated (f32, f64 for the 3D family, fixed for the 2D
+    /// family); each algorithm runs at every one it computes in, and rows
+    /// report their time against f32 [default: f32].
+    #[arg(long, value_delimiter = ',', value_parser = |s: &str| Precision::parse(s).map_err(|e| e.message))]
+    precision: Vec<Precision>,
     /// Folder for results.json and results.csv.
     #[arg(long)]
     out: PathBuf,
@@ -111,6 +118,7 @@ struct Row {
     algorithm: String,
     viewport: String,
     aa: String,
+    precision: Precision,
     width: u32,
     height: u32,
     threads: usize,
@@ -128,6 +136,8 @@ struct Row {
     pixels_differing_from_3dr_brute: Option<u64>,
     /// Time against the same algorithm without anti-aliasing (when measured).
     ratio_to_aa_none: Option<f64>,
+    /// Time against the same algorithm and mode at f32 (when measured).
+    ratio_to_f32: Option<f64>,
     /// Shading evaluations and coverage samples of the render.
     shading_samples: u64,
     coverage_samples: u64,
@@ -153,6 +163,7 @@ impl Row {
             algorithm: algorithm.to_string(),
             viewport: String::new(),
             aa: String::new(),
+            precision: Precision::F32,
             width,
             height,
             threads,
@@ -167,6 +178,7 @@ impl Row {
             agrees: false,
             pixels_differing_from_3dr_brute: None,
             ratio_to_aa_none: None,
+            ratio_to_f32: None,
             shading_samples: 0,
             coverage_samples: 0,
             psnr: None,
@@ -229,7 +241,16 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
     } else {
         args.aa.clone()
     };
-    let total_steps = (scene_args.len() * modes.len() * entries.len()) as u64;
+    // f32 first: the other precisions' rows relate to its times.
+    let precisions: Vec<Precision> = if args.precision.is_empty() {
+        vec![Precision::F32]
+    } else {
+        Precision::ALL
+            .into_iter()
+            .filter(|p| args.precision.contains(p))
+            .collect()
+    };
+    let total_steps = (scene_args.len() * modes.len() * precisions.len() * entries.len()) as u64;
     let progress = indicatif::ProgressBar::new(total_steps).with_style(
         indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} [{elapsed}]")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
@@ -261,43 +282,57 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         };
         let first_row = rows.len();
         for &mode in &modes {
-            let mut mode_rows: Vec<(Row, Vec<u64>)> = Vec::new();
-            for &entry in &entries {
-                progress.set_message(format!("{scene_name} {mode}: {}", entry.name()));
-                let measured = match entry {
-                    Entry::Algorithm(a) => Some(measure_algorithm(
-                        &pool,
-                        &prepared,
-                        &camera,
-                        (a, mode),
-                        args,
-                        threads,
-                        &scene_name,
-                    )?),
-                    // Peers render one sample per pixel.
-                    Entry::Peer(p) if mode == AaMode::None => Some(measure_peer(
-                        &pool,
-                        &prepared,
-                        &view,
-                        p,
-                        args.repeat,
-                        threads,
-                        &scene_name,
-                    )?),
-                    Entry::Peer(_) => None,
-                };
-                if let Some(Measured { mut row, keys, fb }) = measured {
-                    if let (Some(r), Some(fb)) = (&reference, &fb) {
-                        row.error(r.error_of(fb));
+            let mut f32_base = None;
+            for &precision in &precisions {
+                let mut group: Vec<(Row, Vec<u64>)> = Vec::new();
+                for &entry in &entries {
+                    progress
+                        .set_message(format!("{scene_name} {mode} {precision}: {}", entry.name()));
+                    let measured = match entry {
+                        Entry::Algorithm(a) if precision.serves(a.family()) => {
+                            Some(measure_algorithm(
+                                &pool,
+                                &prepared,
+                                &camera,
+                                (a, mode, precision),
+                                args,
+                                threads,
+                                &scene_name,
+                            )?)
+                        }
+                        // Peers render one sample per pixel in their own precision.
+                        Entry::Peer(p) if mode == AaMode::None && precision == Precision::F32 => {
+                            Some(measure_peer(
+                                &pool,
+                                &prepared,
+                                &view,
+                                p,
+                                args.repeat,
+                                threads,
+                                &scene_name,
+                            )?)
+                        }
+                        _ => None,
+                    };
+                    if let Some(Measured { mut row, keys, fb }) = measured {
+                        if let (Some(r), Some(fb)) = (&reference, &fb) {
+                            row.error(r.error_of(fb));
+                        }
+                        group.push((row, keys));
                     }
-                    mode_rows.push((row, keys));
+                    progress.inc(1);
                 }
-                progress.inc(1);
+                // Ratios to 2dr-brute at f32, whatever this group's precision
+                // (f32 comes first).
+                if precision == Precision::F32 {
+                    f32_base = brute_base(&group);
+                }
+                fill_relations(&mut group, f32_base);
+                rows.extend(group.into_iter().map(|(r, _)| r));
             }
-            fill_relations(&mut mode_rows);
-            rows.extend(mode_rows.into_iter().map(|(r, _)| r));
         }
         fill_aa_ratios(&mut rows[first_row..]);
+        fill_precision_ratios(&mut rows[first_row..]);
     }
     progress.finish_and_clear();
 
@@ -356,6 +391,7 @@ impl Reference {
             width,
             height,
             aa,
+            precision: Precision::F32,
         };
         let run = |aa| {
             render(prepared, &request(aa))
@@ -377,15 +413,32 @@ impl Reference {
     }
 }
 
-/// Each row's time against the same scene and algorithm without anti-aliasing.
+/// Each row's time against the same scene, algorithm and precision without
+/// anti-aliasing.
 fn fill_aa_ratios(rows: &mut [Row]) {
-    let none: HashMap<String, f64> = rows
+    let none: HashMap<(String, Precision), f64> = rows
         .iter()
         .filter(|r| r.aa == "none")
-        .map(|r| (r.algorithm.clone(), r.median_ms))
+        .map(|r| ((r.algorithm.clone(), r.precision), r.median_ms))
         .collect();
     for r in rows {
-        r.ratio_to_aa_none = none.get(&r.algorithm).map(|base| r.median_ms / base);
+        r.ratio_to_aa_none = none
+            .get(&(r.algorithm.clone(), r.precision))
+            .map(|base| r.median_ms / base);
+    }
+}
+
+/// Each row's time against the same scene, algorithm and mode at f32.
+fn fill_precision_ratios(rows: &mut [Row]) {
+    let single: HashMap<(String, String), f64> = rows
+        .iter()
+        .filter(|r| r.precision == Precision::F32)
+        .map(|r| ((r.algorithm.clone(), r.aa.clone()), r.median_ms))
+        .collect();
+    for r in rows {
+        r.ratio_to_f32 = single
+            .get(&(r.algorithm.clone(), r.aa.clone()))
+            .map(|base| r.median_ms / base);
     }
 }
 
@@ -402,7 +455,7 @@ fn measure_algorithm(
     pool: &rayon::ThreadPool,
     prepared: &PreparedScene,
     camera: &continuum::Camera,
-    (algorithm, aa): (AlgorithmId, AaMode),
+    (algorithm, aa, precision): (AlgorithmId, AaMode, Precision),
     args: &CompareArgs,
     threads: usize,
     scene: &str,
@@ -414,6 +467,7 @@ fn measure_algorithm(
         width: args.size.0,
         height: args.size.1,
         aa,
+        precision,
     };
     let mut out = pool
         .install(|| render(prepared, &request))
@@ -438,6 +492,7 @@ fn measure_algorithm(
         serde_json::to_value(&out.stats).unwrap_or(Value::Null),
     )
     .hashes(serde_json::to_value(&out.hashes).unwrap_or(Value::Null));
+    row.precision = precision;
     row.shading_samples = out.stats.shading_samples;
     row.coverage_samples = out.stats.coverage_samples;
     let fb = out.framebuffer;
@@ -485,15 +540,19 @@ fn measure_peer(
     })
 }
 
-/// Ratios to 2dr-brute, family agreement and peer differences within one scene
-/// and anti-aliasing mode.
-fn fill_relations(rows: &mut [(Row, Vec<u64>)]) {
+/// 2dr-brute's median time and predicted instructions in `rows`, if measured.
+fn brute_base(rows: &[(Row, Vec<u64>)]) -> Option<(f64, Option<f64>)> {
+    rows.iter()
+        .find(|(r, _)| r.algorithm == "2dr-brute")
+        .map(|(r, _)| (r.median_ms, r.stats["predicted_instructions"].as_f64()))
+}
+
+/// Ratios to `base` (2dr-brute's time and predicted instructions), family
+/// agreement and peer differences within one scene, anti-aliasing mode and
+/// precision.
+fn fill_relations(rows: &mut [(Row, Vec<u64>)], base: Option<(f64, Option<f64>)>) {
     let find =
         |rows: &[(Row, Vec<u64>)], name: &str| rows.iter().position(|(r, _)| r.algorithm == name);
-    let base = find(rows, "2dr-brute").map(|i| {
-        let r = &rows[i].0;
-        (r.median_ms, r.stats["predicted_instructions"].as_f64())
-    });
     let three_d = find(rows, "3dr-brute").map(|i| rows[i].1.clone());
     // The first member of each family present is its reference.
     let mut family_reference: HashMap<String, usize> = HashMap::new();
@@ -549,7 +608,7 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
     let mut f =
         std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
     let mut text = String::from(
-        "scene,algorithm,aa,width,height,threads,median_ms,min_ms,max_ms,ratio_to_2dr_brute,predicted_ratio,rays_per_second,triangle_setups,edge_evaluations,bvh_nodes_visited,agrees,pixels_differing_from_3dr_brute,triangle_id_hash,ratio_to_aa_none,shading_samples,coverage_samples,psnr,psnr_edges,flip_mean\n",
+        "scene,algorithm,aa,precision,width,height,threads,median_ms,min_ms,max_ms,ratio_to_2dr_brute,predicted_ratio,rays_per_second,triangle_setups,edge_evaluations,bvh_nodes_visited,agrees,pixels_differing_from_3dr_brute,triangle_id_hash,ratio_to_aa_none,ratio_to_f32,shading_samples,coverage_samples,psnr,psnr_edges,flip_mean\n",
     );
     let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.4}"));
     for r in rows {
@@ -560,10 +619,11 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
                 .map_or(String::new(), |v| v.to_string())
         };
         text.push_str(&format!(
-            "{},{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{:.0},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{:.0},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             r.scene,
             r.algorithm,
             r.aa,
+            r.precision,
             r.width,
             r.height,
             r.threads,
@@ -584,6 +644,7 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
                 .and_then(Value::as_str)
                 .unwrap_or(""),
             opt(r.ratio_to_aa_none),
+            opt(r.ratio_to_f32),
             r.shading_samples,
             r.coverage_samples,
             opt(r.psnr),
@@ -598,14 +659,16 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
 
 fn print_table(rows: &[Row]) {
     println!(
-        "{:<12} {:<18} {:<10} {:>10} {:>8} {:>9} {:>7} {:>9} {:>9} {:>7} {:>7}",
+        "{:<12} {:<18} {:<10} {:<5} {:>10} {:>8} {:>9} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
         "scene",
         "algorithm",
         "aa",
+        "prec",
         "median ms",
         "ratio",
         "predicted",
         "x none",
+        "x f32",
         "PSNR dB",
         "edges dB",
         "FLIP",
@@ -614,14 +677,16 @@ fn print_table(rows: &[Row]) {
     for r in rows {
         let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.2}"));
         println!(
-            "{:<12} {:<18} {:<10} {:>10.2} {:>8} {:>9} {:>7} {:>9} {:>9} {:>7} {:>7}",
+            "{:<12} {:<18} {:<10} {:<5} {:>10.2} {:>8} {:>9} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
             r.scene,
             r.algorithm,
             r.aa,
+            r.precision,
             r.median_ms,
             opt(r.ratio_to_2dr_brute),
             opt(r.predicted_ratio),
             opt(r.ratio_to_aa_none),
+            opt(r.ratio_to_f32),
             opt(r.psnr),
             opt(r.psnr_edges),
             r.flip_mean.map_or("-".to_string(), |v| format!("{v:.4}")),

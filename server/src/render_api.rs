@@ -11,7 +11,7 @@ use base64::Engine;
 use continuum::request::{
     CameraSpec, FieldError, parse_aa, parse_algorithm, parse_size, parse_viewport,
 };
-use continuum::{AaMode, AlgorithmId, RenderOutput, RenderRequest, Viewport, maps};
+use continuum::{AaMode, AlgorithmId, Precision, RenderOutput, RenderRequest, Viewport, maps};
 use serde::Deserialize;
 use serde_json::{Value, json};
 
@@ -28,6 +28,7 @@ pub struct RenderBody {
     pub oracles: Option<String>,
     pub viewport: Option<String>,
     pub aa: Option<String>,
+    pub precision: Option<String>,
     pub size: Option<String>,
     pub outputs: Option<Vec<String>>,
 }
@@ -44,6 +45,7 @@ struct Checked {
     viewport: Option<String>,
     size: (u32, u32),
     aa: AaMode,
+    precision: Precision,
 }
 
 fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
@@ -123,6 +125,15 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
     if let Some(text) = &body.oracles {
         algorithm.pipeline().with_oracles(text)?;
     }
+    let precision = body
+        .precision
+        .as_deref()
+        .map(Precision::parse)
+        .transpose()?
+        .unwrap_or_default();
+    if !precision.serves(algorithm.family()) {
+        return Err(precision.unsupported(algorithm).into());
+    }
     Ok(Checked {
         scene: body.scene.clone(),
         algorithm,
@@ -131,6 +142,7 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
         viewport: body.viewport.clone(),
         size,
         aa,
+        precision,
     })
 }
 
@@ -163,6 +175,7 @@ async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, 
             width: c.size.0,
             height: c.size.1,
             aa: c.aa,
+            precision: c.precision,
         };
         let out = continuum::render(&prepared, &request)
             .map_err(|e| ApiError::bad_request(e.field, e.to_string()))?;
@@ -230,6 +243,7 @@ pub struct RenderQuery {
     oracles: Option<String>,
     viewport: Option<String>,
     aa: Option<String>,
+    precision: Option<String>,
     size: Option<String>,
     output: Option<String>,
 }
@@ -254,6 +268,7 @@ pub async fn render_png(
         oracles: q.oracles,
         viewport: q.viewport,
         aa: q.aa,
+        precision: q.precision,
         size: q.size,
         outputs: Some(vec![output.clone()]),
     };

@@ -63,6 +63,7 @@ pub fn render_with_oracles(
             width,
             height,
             aa: continuum::AaMode::None,
+            precision: Default::default(),
         },
     )
     .unwrap_or_else(|e| panic!("{algorithm} {oracles:?}: {e}"))
@@ -85,6 +86,7 @@ pub fn render_aa(
             width,
             height,
             aa,
+            precision: Default::default(),
         },
     )
     .unwrap_or_else(|e| panic!("{algorithm} {aa}: {e}"))

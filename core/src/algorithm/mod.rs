@@ -29,13 +29,14 @@ pub use crate::binning::SampleOracles;
 use crate::aa::resolve::resolve_tile;
 use crate::aa::{SamplePattern, SampleSpan};
 use crate::camera::{View, Viewport};
-use crate::edge::{CurvedTriangle, Triangle3D};
+use crate::edge::{CurvedTriangle, Triangle3D, Triangle3D64};
 use crate::framebuffer::{Framebuffer, ResolvedTile, TileBuffer};
+use crate::precision::Precision;
 use crate::prepared::PreparedScene;
 use crate::request::FieldError;
 use crate::shade::Shader;
 use crate::stats::{CoverageHistogram, RasterCounters, Stats};
-use crate::traversal::{Traversal, TraversalOracles};
+use crate::traversal::{Setup, Traversal, TraversalOracles};
 use tiles::rasterize_tiled;
 
 /// Which algorithm renders a request. The string forms are stable ids.
@@ -300,11 +301,13 @@ impl Pipeline {
     }
 }
 
-/// Renders `view` of `scene` with `pipeline` into `fb`: the pixels, counters
-/// and stage times. The viewport must be one the pipeline
-/// [serves](Pipeline::serves).
+/// Renders `view` of `scene` with `pipeline` at `precision` into `fb`: the
+/// pixels, counters and stage times. The viewport must be one the pipeline
+/// [serves](Pipeline::serves), the precision one its family computes in
+/// (f64 on non-planar viewports is their f64 curved edges).
 pub(crate) fn run(
     pipeline: Pipeline,
+    precision: Precision,
     scene: &PreparedScene,
     view: &View,
     pattern: &SamplePattern,
@@ -316,80 +319,93 @@ pub(crate) fn run(
         pattern,
         shader: Shader::new(scene),
     };
+    let f64 = precision == Precision::F64;
     let pass = match pipeline {
         Pipeline::AllTriangles { edges, samples } => {
             let start = Instant::now();
             let span = pattern.span;
+            // One generic call per edge kind (a closure cannot be generic).
+            macro_rules! tiles {
+                ($items:expr) => {
+                    timed_tiles(&$items, fb, samples, &context, stats, start)
+                };
+            }
             match edges {
-                EdgeKind::TwoD => timed_tiles(
-                    &setup2d::setup_2d(scene, view, span),
-                    fb,
-                    samples,
-                    &context,
-                    stats,
-                    start,
-                ),
-                EdgeKind::Homogeneous => timed_tiles(
-                    &setup3d::setup_homogeneous(scene, view, span),
-                    fb,
-                    samples,
-                    &context,
-                    stats,
-                    start,
-                ),
+                EdgeKind::TwoD if precision == Precision::Fixed => {
+                    tiles!(setup2d::setup_2d_fixed(scene, view, span))
+                }
+                EdgeKind::TwoD => tiles!(setup2d::setup_2d(scene, view, span)),
+                EdgeKind::Homogeneous => {
+                    tiles!(setup3d::setup_homogeneous(scene, view, span))
+                }
                 EdgeKind::ThreeD if view.sphere.is_some() => {
                     let mut items = setup3d::setup_curved(scene, view, span);
                     if samples.incremental {
                         items.iter_mut().for_each(|p| p.tri.incremental = true);
                     }
-                    timed_tiles(&items, fb, samples, &context, stats, start)
+                    tiles!(items)
                 }
-                EdgeKind::ThreeD => timed_tiles(
-                    &setup3d::setup_3d(scene, view, span),
-                    fb,
-                    samples,
-                    &context,
-                    stats,
-                    start,
-                ),
+                EdgeKind::ThreeD if f64 => {
+                    tiles!(setup3d::setup_3d_f64(scene, view, span))
+                }
+                EdgeKind::ThreeD => tiles!(setup3d::setup_3d(scene, view, span)),
             }
         }
+        Pipeline::Frusta(oracles) if f64 => {
+            render_frusta(scene, &context, oracles, fb, stats, Triangle3D64::setup)
+        }
         Pipeline::Frusta(oracles) => {
-            let start = Instant::now();
-            let done: Vec<_> = fb
-                .tile_rects(oracles.frustum)
-                .into_par_iter()
-                .map_init(
-                    || None,
-                    |cache, rect| {
-                        context.run_tile(cache, rect, |tile| {
-                            let mut t = Traversal::new(scene, view, oracles, tile);
-                            t.run();
-                            (t.counters, t.nodes_visited, t.setups)
-                        })
-                    },
-                )
-                .collect();
-            let mut pass = Pass::default();
-            for finished in done {
-                let (counters, nodes, setups) = finished.result;
-                pass.store(fb, &finished.map(|_| counters));
-                stats.bvh_nodes_visited += nodes;
-                stats.triangle_setups += setups;
-            }
-            let (traversal, shading) = pass.split(start.elapsed().as_secs_f64() * 1e3);
-            stats.time_ms.traversal = traversal;
-            stats.time_ms.shading = shading;
-            pass
+            render_frusta(scene, &context, oracles, fb, stats, Triangle3D::setup)
         }
         Pipeline::Rays if view.sphere.is_some() => {
             raycast::render_raycast(scene, &context, fb, stats, CurvedTriangle::setup)
+        }
+        Pipeline::Rays if f64 => {
+            raycast::render_raycast(scene, &context, fb, stats, Triangle3D64::setup)
         }
         Pipeline::Rays => raycast::render_raycast(scene, &context, fb, stats, Triangle3D::setup),
     };
     stats.counters = pass.counters;
     stats.coverage_histogram = pass.histogram;
     stats.shading_samples = pass.shading_samples;
+}
+
+/// The Fig. 7 traversal, one initial frustum per parallel work item, leaf
+/// triangles set up by `setup`.
+fn render_frusta<T: crate::edge::Coverage>(
+    scene: &PreparedScene,
+    context: &TileContext,
+    oracles: TraversalOracles,
+    fb: &mut Framebuffer,
+    stats: &mut Stats,
+    setup: Setup<T>,
+) -> Pass {
+    let start = Instant::now();
+    let done: Vec<_> = fb
+        .tile_rects(oracles.frustum)
+        .into_par_iter()
+        .map_init(
+            || None,
+            |cache, rect| {
+                context.run_tile(cache, rect, |tile| {
+                    let mut t = Traversal::new(scene, context.view, oracles, tile, setup);
+                    t.run();
+                    (t.counters, t.nodes_visited, t.setups)
+                })
+            },
+        )
+        .collect();
+    let mut pass = Pass::default();
+    for finished in done {
+        let (counters, nodes, setups) = finished.result;
+        pass.store(fb, &finished.map(|_| counters));
+        stats.bvh_nodes_visited += nodes;
+        stats.triangle_setups += setups;
+    }
+    let (traversal, shading) = pass.split(start.elapsed().as_secs_f64() * 1e3);
+    stats.time_ms.traversal = traversal;
+    stats.time_ms.shading = shading;
+    pass
 }
 
 fn timed_tiles<T: crate::edge::Coverage + Sync>(

@@ -1,6 +1,8 @@
 //! Setup of the 2D family (paper §3.1): transform to camera space, clip against
 //! the near plane and a guard band (Sutherland–Hodgman), project, set up 2D edge
-//! functions (top-left rule, perspective-correct w) per piece of the clipped polygon.
+//! functions (top-left rule, perspective-correct w) per piece of the clipped
+//! polygon — in f32 ([`Triangle2D`]) or on snapped vertices in fixed point
+//! ([`Triangle2DFixed`]).
 
 use rayon::prelude::*;
 
@@ -9,16 +11,44 @@ use super::tiles::Placed;
 use crate::aa::SampleSpan;
 use crate::camera::View;
 use crate::clip::{clip_triangle, pipeline_planes};
-use crate::edge::{ScreenVertex, Triangle2D};
+use crate::edge::{ScreenVertex, Triangle2D, Triangle2DFixed};
 use crate::prepared::PreparedScene;
 
-/// Every drawable triangle, clipped, projected and set up; pieces without
-/// samples on screen are dropped.
+/// Every drawable triangle, clipped, projected and set up with f32 edge
+/// functions; pieces without samples on screen are dropped.
 pub(crate) fn setup_2d(
     scene: &PreparedScene,
     view: &View,
     span: SampleSpan,
 ) -> Vec<Placed<Triangle2D>> {
+    let affine = view.is_orthographic();
+    setup_pieces(scene, view, span, |v| {
+        let t = Triangle2D::setup(v, affine, view.width, view.height)?;
+        Some((t, t.bounds))
+    })
+}
+
+/// As [`setup_2d`], with vertices snapped to 1/256 pixel and exact edge functions.
+pub(crate) fn setup_2d_fixed(
+    scene: &PreparedScene,
+    view: &View,
+    span: SampleSpan,
+) -> Vec<Placed<Triangle2DFixed>> {
+    let affine = view.is_orthographic();
+    setup_pieces(scene, view, span, |v| {
+        let t = Triangle2DFixed::setup(v, affine)?;
+        Some((t, t.bounds))
+    })
+}
+
+/// Clips, projects and fan-triangulates every drawable triangle; `make` sets up
+/// each piece and gives its pixel bounds `[min_x, min_y, max_x, max_y]`.
+fn setup_pieces<T: Send>(
+    scene: &PreparedScene,
+    view: &View,
+    span: SampleSpan,
+    make: impl Fn(&[ScreenVertex; 3]) -> Option<(T, [f32; 4])> + Sync,
+) -> Vec<Placed<T>> {
     let planes = pipeline_planes(view);
     let affine = view.is_orthographic();
     scene
@@ -51,15 +81,10 @@ pub(crate) fn setup_2d(
             }
             // 3. Fan-triangulate and set up each piece.
             for k in 1..poly.len - 1 {
-                let Some(tri) = Triangle2D::setup(
-                    &[screen[0], screen[k], screen[k + 1]],
-                    affine,
-                    view.width,
-                    view.height,
-                ) else {
+                let Some((tri, [x0, y0, x1, y1])) = make(&[screen[0], screen[k], screen[k + 1]])
+                else {
                     continue;
                 };
-                let [x0, y0, x1, y1] = tri.bounds;
                 if let Some(rect) =
                     PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height, span)
                 {

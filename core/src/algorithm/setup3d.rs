@@ -10,7 +10,7 @@ use super::tiles::Placed;
 use crate::aa::SampleSpan;
 use crate::camera::View;
 use crate::clip::{ClipPlane, clip_triangle};
-use crate::edge::{self, CurvedTriangle, Triangle3D};
+use crate::edge::{self, CurvedTriangle, Triangle3D, Triangle3D64};
 use crate::prepared::PreparedScene;
 
 /// Every drawable triangle with samples on screen, set up with 3D edge functions.
@@ -20,6 +20,15 @@ pub(crate) fn setup_3d(
     span: SampleSpan,
 ) -> Vec<Placed<Triangle3D>> {
     setup_visible(scene, view, span, Triangle3D::setup)
+}
+
+/// [`setup_3d`] in f64.
+pub(crate) fn setup_3d_f64(
+    scene: &PreparedScene,
+    view: &View,
+    span: SampleSpan,
+) -> Vec<Placed<Triangle3D64>> {
+    setup_visible(scene, view, span, Triangle3D64::setup)
 }
 
 /// Every drawable triangle with samples on a non-planar viewport, set up with 3D

@@ -5,18 +5,25 @@
 //! - [`Triangle2D`]: projected 2D edge functions (paper §3.1).
 //! - [`CurvedTriangle`]: 3D edge functions against the per-sample directions of
 //!   a non-planar viewport (paper §3.5).
+//! - [`Triangle2DFixed`] and [`Triangle3D64`]: the 2D functions on vertices
+//!   snapped to 1/256 pixel and evaluated exactly (hardware rules), and the 3D
+//!   functions in f64 (`--precision fixed`, `--precision f64`).
 //!
 //! Both decide a sample that lies exactly on an edge with the same top-left rule
 //! ([`owns_tie`]), so every sample of a closed mesh is covered exactly once.
 
 mod curved;
 mod edge2d;
+pub mod edge2d_fixed;
 mod edge3d;
+mod edge3d_f64;
 mod homogeneous;
 
 pub use curved::CurvedTriangle;
 pub use edge2d::{ScreenVertex, Triangle2D};
+pub use edge2d_fixed::Triangle2DFixed;
 pub use edge3d::Triangle3D;
+pub use edge3d_f64::Triangle3D64;
 pub use homogeneous::setup_homogeneous;
 
 /// The tie rule of paper §3.4 (Direct3D's top-left rule written with derivatives):

@@ -85,6 +85,7 @@ fn bad_oracles_are_errors_naming_the_field() {
                 width: 8,
                 height: 8,
                 aa: continuum::AaMode::None,
+                precision: Default::default(),
             },
         )
         .expect_err(text);

@@ -178,6 +178,7 @@ fn incremental_evaluation_decides_like_direct_evaluation() {
             width: 64,
             height: 32,
             aa: continuum::AaMode::None,
+            precision: Default::default(),
         },
     )
     .unwrap_err();
@@ -243,6 +244,7 @@ fn unsupported_pairings_are_errors_listing_the_supported_ones() {
                     width: 32,
                     height: 16,
                     aa: continuum::AaMode::None,
+                    precision: Default::default(),
                 },
             );
             let served = matches!(
