@@ -22,6 +22,8 @@ pub mod camera;
 pub mod clip;
 pub mod edge;
 pub mod framebuffer;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 pub mod maps;
 pub mod metrics;
 pub mod peer;

@@ -28,6 +28,9 @@ pub struct PreparedScene {
     pub bounds: Bounds,
     /// Near distance for cameras that give none: 1e-3 of the bounding radius.
     pub default_near: f32,
+    /// The drawable triangles on the GPU, uploaded by the first `gpu-raster` render.
+    #[cfg(feature = "gpu")]
+    pub(crate) gpu_mesh: std::sync::OnceLock<Result<crate::gpu::GpuMesh, crate::gpu::GpuError>>,
 }
 
 impl PreparedScene {
@@ -74,6 +77,8 @@ impl PreparedScene {
             bounds,
             default_near: radius * 1e-3,
             scene,
+            #[cfg(feature = "gpu")]
+            gpu_mesh: std::sync::OnceLock::new(),
         }
     }
 

@@ -6,7 +6,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::aa::AaMode;
-use crate::algorithm::{self, AlgorithmId};
+use crate::algorithm::{self, AlgorithmId, Pipeline};
 use crate::camera::{Camera, CameraError, View, Viewport};
 use crate::framebuffer::Framebuffer;
 use crate::precision::Precision;
@@ -162,15 +162,19 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
         )
         .into());
     }
-    algorithm::run(
-        pipeline,
-        request.precision,
-        scene,
-        &view,
-        &pattern,
-        &mut fb,
-        &mut stats,
-    );
+    if pipeline == Pipeline::Gpu {
+        render_on_gpu(scene, request, &view, &mut fb, &mut stats)?;
+    } else {
+        algorithm::run(
+            pipeline,
+            request.precision,
+            scene,
+            &view,
+            &pattern,
+            &mut fb,
+            &mut stats,
+        );
+    }
 
     stats.edge_evaluations = fb.edge_evals.iter().map(|&e| u64::from(e)).sum();
     stats.max_edge_evals_per_pixel = fb.edge_evals.iter().copied().max().unwrap_or(0);
@@ -192,5 +196,49 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
         framebuffer: fb,
         stats,
         hashes,
+    })
+}
+
+/// `gpu-raster`: one sample per pixel through the hardware pipeline.
+#[cfg(feature = "gpu")]
+fn render_on_gpu(
+    scene: &PreparedScene,
+    request: &RenderRequest,
+    view: &View,
+    fb: &mut Framebuffer,
+    stats: &mut Stats,
+) -> Result<(), RenderError> {
+    use crate::gpu::GpuError;
+    if request.aa != AaMode::None {
+        return Err(FieldError::new(
+            "aa",
+            format!(
+                "gpu-raster renders one sample per pixel; not aa {}",
+                request.aa
+            ),
+        )
+        .into());
+    }
+    crate::gpu::render_gpu_raster(scene, view, fb, stats).map_err(|e| RenderError {
+        field: match e {
+            GpuError::TooLarge { .. } => "size",
+            GpuError::SceneTooLarge { .. } => "scene",
+            _ => "algorithm",
+        },
+        message: e.to_string(),
+    })
+}
+
+#[cfg(not(feature = "gpu"))]
+fn render_on_gpu(
+    _: &PreparedScene,
+    _: &RenderRequest,
+    _: &View,
+    _: &mut Framebuffer,
+    _: &mut Stats,
+) -> Result<(), RenderError> {
+    Err(RenderError {
+        field: "algorithm",
+        message: "gpu-raster needs continuum built with the `gpu` feature".into(),
     })
 }

@@ -11,6 +11,7 @@
 //! | `3dr-frustum-split` | BVH, frusta split to 8², outside + occlusion culling | per sample at leaves |
 //! | `3dr-full` | as split | binning + early-z at leaves |
 //! | `raycast` | CWBVH walked per ray | one sample per ray, the same 3D edges |
+//! | `gpu-raster` | the wgpu hardware pipeline (feature `gpu`) | the driver's fixed-point rules |
 
 mod raycast;
 pub(crate) mod setup2d;
@@ -60,6 +61,8 @@ pub enum AlgorithmId {
     ThreeDFull,
     /// One ray per sample through the BVH, hits decided by the 3D edge functions.
     Raycast,
+    /// The wgpu hardware pipeline (lavapipe without a GPU): reference and peer.
+    GpuRaster,
 }
 
 /// The family an algorithm belongs to: within a family results agree bit for bit.
@@ -74,6 +77,9 @@ pub enum Family {
     /// 3D edge functions (rasterizers and the ray caster).
     #[serde(rename = "3d")]
     ThreeD,
+    /// The GPU's own rasterizer.
+    #[serde(rename = "gpu")]
+    Gpu,
 }
 
 /// Which edge functions an all-triangles pipeline sets up.
@@ -96,10 +102,28 @@ pub enum Pipeline {
     Frusta(TraversalOracles),
     /// One ray per sample through the BVH.
     Rays,
+    /// The GPU's hardware pipeline.
+    Gpu,
 }
 
 impl AlgorithmId {
-    pub const ALL: [AlgorithmId; 9] = [
+    /// Every algorithm: the CPU ones and `gpu-raster`.
+    pub const ALL: [AlgorithmId; 10] = [
+        AlgorithmId::TwoDBrute,
+        AlgorithmId::TwoDBin,
+        AlgorithmId::TwoDHomogeneous,
+        AlgorithmId::ThreeDBrute,
+        AlgorithmId::ThreeDBin,
+        AlgorithmId::ThreeDFrustumCull,
+        AlgorithmId::ThreeDFrustumSplit,
+        AlgorithmId::ThreeDFull,
+        AlgorithmId::Raycast,
+        AlgorithmId::GpuRaster,
+    ];
+
+    /// The algorithms continuum computes itself, on the CPU: within each family
+    /// their results agree bit for bit.
+    pub const CPU: [AlgorithmId; 9] = [
         AlgorithmId::TwoDBrute,
         AlgorithmId::TwoDBin,
         AlgorithmId::TwoDHomogeneous,
@@ -122,6 +146,7 @@ impl AlgorithmId {
             AlgorithmId::ThreeDFrustumSplit => "3dr-frustum-split",
             AlgorithmId::ThreeDFull => "3dr-full",
             AlgorithmId::Raycast => "raycast",
+            AlgorithmId::GpuRaster => "gpu-raster",
         }
     }
 
@@ -129,6 +154,7 @@ impl AlgorithmId {
         match self {
             AlgorithmId::TwoDBrute | AlgorithmId::TwoDBin => Family::TwoD,
             AlgorithmId::TwoDHomogeneous => Family::Homogeneous,
+            AlgorithmId::GpuRaster => Family::Gpu,
             _ => Family::ThreeD,
         }
     }
@@ -158,6 +184,9 @@ impl AlgorithmId {
             }
             AlgorithmId::Raycast => {
                 "ray casting through a CWBVH, hits decided by the same 3D edge functions"
+            }
+            AlgorithmId::GpuRaster => {
+                "the GPU's hardware pipeline through wgpu (Mesa lavapipe without a GPU): the reference from outside"
             }
         }
     }
@@ -202,6 +231,7 @@ impl AlgorithmId {
             AlgorithmId::ThreeDFrustumSplit => frusta(true, true, Some(8), SampleOracles::BRUTE),
             AlgorithmId::ThreeDFull => frusta(true, true, Some(8), SampleOracles::BINNED),
             AlgorithmId::Raycast => Pipeline::Rays,
+            AlgorithmId::GpuRaster => Pipeline::Gpu,
         }
     }
 }
@@ -233,6 +263,7 @@ impl Pipeline {
                 Pipeline::AllTriangles { samples, .. } => samples,
                 Pipeline::Frusta(t) => &mut t.samples,
                 Pipeline::Rays => return Err(bad("raycast takes no oracles".into())),
+                Pipeline::Gpu => return Err(bad("gpu-raster takes no oracles".into())),
             };
             match key {
                 "binning" => samples.binning = switch()?,
@@ -276,18 +307,20 @@ impl Pipeline {
             )
     }
 
-    /// How samples are enumerated (`None` for the ray caster).
+    /// How samples are enumerated (`None` for the ray caster and the GPU).
     pub fn samples(self) -> Option<SampleOracles> {
         match self {
             Pipeline::AllTriangles { samples, .. } => Some(samples),
             Pipeline::Frusta(t) => Some(t.samples),
-            Pipeline::Rays => None,
+            Pipeline::Rays | Pipeline::Gpu => None,
         }
     }
 
-    /// The paper's Fig. 10 scalar instruction costs: (setup, per sample).
+    /// The paper's Fig. 10 scalar instruction costs: (setup, per sample); the
+    /// GPU's are not modelled (zero).
     pub fn instruction_costs(self) -> (u64, u64) {
         match self {
+            Pipeline::Gpu => (0, 0),
             Pipeline::AllTriangles {
                 edges: EdgeKind::TwoD,
                 ..
@@ -364,6 +397,7 @@ pub(crate) fn run(
             raycast::render_raycast(scene, &context, fb, stats, Triangle3D64::setup)
         }
         Pipeline::Rays => raycast::render_raycast(scene, &context, fb, stats, Triangle3D::setup),
+        Pipeline::Gpu => unreachable!("gpu-raster renders through crate::gpu"),
     };
     stats.counters = pass.counters;
     stats.coverage_histogram = pass.histogram;

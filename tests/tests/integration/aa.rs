@@ -156,7 +156,7 @@ fn closed_geometry_is_covered_once_per_sample() {
             },
             AaMode::Ssaa(16),
         ] {
-            for algorithm in AlgorithmId::ALL {
+            for algorithm in AlgorithmId::CPU {
                 let (w, h) = (67, 43);
                 let out = render_aa(&prepared, algorithm, &camera, (w, h), mode);
                 let hist = out.stats.coverage_histogram;
@@ -197,7 +197,7 @@ fn algorithms_agree_per_sample() {
             camera.viewport = viewport;
             for mode in modes {
                 let mut reference: Vec<(Family, String, continuum::Hashes)> = Vec::new();
-                for algorithm in AlgorithmId::ALL.into_iter().filter(|a| viewport.serves(*a)) {
+                for algorithm in AlgorithmId::CPU.into_iter().filter(|a| viewport.serves(*a)) {
                     let out = render_aa(&scene, algorithm, &camera, (64, 48), mode);
                     match reference.iter().find(|(f, _, _)| *f == algorithm.family()) {
                         Some((_, first, hashes)) => assert_eq!(
@@ -271,7 +271,7 @@ fn shading_runs_once_per_pixel_and_triangle_or_once_per_sample() {
             }
         }
         assert!(expected > 20, "{mode}: a test that shades nothing");
-        for algorithm in AlgorithmId::ALL {
+        for algorithm in AlgorithmId::CPU {
             let out = render_aa(&scene, algorithm, &exact_camera(), (8, 8), mode);
             assert_eq!(out.stats.shading_samples, expected, "{mode} {algorithm}");
         }

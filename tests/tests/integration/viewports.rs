@@ -75,7 +75,7 @@ fn three_d_family_and_raycast_agree_on_every_viewport() {
                     .filter(|&&id| id != continuum::BACKGROUND)
                     .count();
                 assert!(covered > 0, "{what}: nothing drawn");
-                let served = AlgorithmId::ALL
+                let served = AlgorithmId::CPU
                     .into_iter()
                     .filter(|a| a.family() == Family::ThreeD && viewport.serves(*a));
                 for algorithm in served.skip(1) {
@@ -234,7 +234,7 @@ fn unsupported_pairings_are_errors_listing_the_supported_ones() {
     let scene = prepared("box");
     for viewport in [Viewport::Parabolic, Viewport::LatLong] {
         let camera = with_viewport(&scene.scene.first_camera(), viewport);
-        for algorithm in AlgorithmId::ALL {
+        for algorithm in AlgorithmId::CPU {
             let result = render(
                 &scene,
                 &RenderRequest {
