@@ -46,16 +46,34 @@ impl ClipPlane {
     }
 }
 
-/// The five planes of the 2D pipeline: near, then the guard band's left, right,
-/// bottom and top: perspective `x/w ∈ [−G·half_x, G·half_x]`, orthographic
-/// `x ∈ [−G·half_x, G·half_x]`, likewise `y`.
-pub fn pipeline_planes(view: &View) -> [ClipPlane; 5] {
-    planes_for(view.near, view.half_x, view.half_y, view.is_orthographic())
+/// Half-extent in pixels of the guard band of `--precision fixed`: coordinates
+/// stay within 2¹⁴ pixels of the image centre, inside the 16.8 fixed-point range
+/// (±2¹⁵), so clipping hardly ever moves an edge before snapping.
+pub const FIXED_GUARD_PIXELS: f32 = 16384.0;
+
+/// The guard band of `--precision fixed`, in units of the screen half-extents
+/// (`x` and `y`): [`FIXED_GUARD_PIXELS`] from the image centre, at least [`GUARD_BAND`].
+pub fn fixed_guard_band(view: &View) -> [f32; 2] {
+    let g = |pixels: u32| (FIXED_GUARD_PIXELS / (pixels as f32 * 0.5)).max(GUARD_BAND);
+    [g(view.width), g(view.height)]
 }
 
-fn planes_for(near: f32, half_x: f32, half_y: f32, orthographic: bool) -> [ClipPlane; 5] {
-    let gx = GUARD_BAND * half_x;
-    let gy = GUARD_BAND * half_y;
+/// The five planes of the 2D pipeline: near, then the guard band's left, right,
+/// bottom and top: perspective `x/w ∈ [−G·half_x, G·half_x]`, orthographic
+/// `x ∈ [−G·half_x, G·half_x]`, likewise `y`, with `guard = [G_x, G_y]` in units
+/// of the half-extents ([`GUARD_BAND`] for f32, [`fixed_guard_band`] for fixed point).
+pub fn pipeline_planes(view: &View, guard: [f32; 2]) -> [ClipPlane; 5] {
+    planes_for(
+        view.near,
+        guard[0] * view.half_x,
+        guard[1] * view.half_y,
+        view.is_orthographic(),
+    )
+}
+
+/// The near plane and the guard band's four planes at `x = ±gx`, `y = ±gy`
+/// (perspective: on `x/w`, `y/w`).
+fn planes_for(near: f32, gx: f32, gy: f32, orthographic: bool) -> [ClipPlane; 5] {
     let side = |k: Vec3, g: f32| {
         if orthographic {
             ClipPlane { k, offset: -g }
@@ -141,7 +159,7 @@ mod tests {
 
     #[test]
     fn untouched_triangle_is_returned_as_is() {
-        let planes = planes_for(0.1, 1.0, 1.0, false);
+        let planes = planes_for(0.1, GUARD_BAND, GUARD_BAND, false);
         let tri = [
             Vec3::new(0.0, 0.0, 1.0),
             Vec3::new(0.1, 0.0, 1.0),
@@ -153,7 +171,7 @@ mod tests {
 
     #[test]
     fn near_plane_cuts_a_triangle_through_the_eye_plane() {
-        let planes = planes_for(0.5, 1.0, 1.0, false);
+        let planes = planes_for(0.5, GUARD_BAND, GUARD_BAND, false);
         let tri = [
             Vec3::new(0.0, 0.0, -1.0),
             Vec3::new(0.2, 0.0, 2.0),
@@ -166,7 +184,7 @@ mod tests {
 
     #[test]
     fn shared_edge_clips_to_identical_vertices_in_both_orders() {
-        let planes = planes_for(0.5, 1.0, 1.0, false);
+        let planes = planes_for(0.5, GUARD_BAND, GUARD_BAND, false);
         let (a, b) = (Vec3::new(0.1, 0.3, -0.7), Vec3::new(0.3, -0.2, 3.1));
         let t1 = clip_triangle([a, b, Vec3::new(0.5, 0.5, 2.0)], &planes).expect("visible");
         let t2 = clip_triangle([b, a, Vec3::new(-0.5, 0.5, 2.0)], &planes).expect("visible");
@@ -187,7 +205,7 @@ mod tests {
 
     #[test]
     fn triangle_behind_the_eye_vanishes() {
-        let planes = planes_for(0.1, 1.0, 1.0, false);
+        let planes = planes_for(0.1, GUARD_BAND, GUARD_BAND, false);
         let tri = [
             Vec3::new(0.0, 0.0, -1.0),
             Vec3::new(1.0, 0.0, -1.0),

@@ -92,6 +92,29 @@ pub fn render_aa(
     .unwrap_or_else(|e| panic!("{algorithm} {aa}: {e}"))
 }
 
+/// Renders at `precision` (one sample per pixel), panicking on error.
+pub fn render_precise(
+    scene: &PreparedScene,
+    algorithm: AlgorithmId,
+    camera: &Camera,
+    (width, height): (u32, u32),
+    precision: continuum::Precision,
+) -> RenderOutput {
+    render(
+        scene,
+        &RenderRequest {
+            algorithm,
+            oracles: None,
+            camera: camera.clone(),
+            width,
+            height,
+            aa: continuum::AaMode::None,
+            precision,
+        },
+    )
+    .unwrap_or_else(|e| panic!("{algorithm} {precision}: {e}"))
+}
+
 /// Pixels where two triangle-id buffers differ, as `(x, y, a, b)`.
 pub fn id_differences(a: &RenderOutput, b: &RenderOutput) -> Vec<(u32, u32, u32, u32)> {
     let w = a.framebuffer.width;

@@ -10,7 +10,7 @@ use super::PixelRect;
 use super::tiles::Placed;
 use crate::aa::SampleSpan;
 use crate::camera::View;
-use crate::clip::{clip_triangle, pipeline_planes};
+use crate::clip::{GUARD_BAND, clip_triangle, fixed_guard_band, pipeline_planes};
 use crate::edge::{ScreenVertex, Triangle2D, Triangle2DFixed};
 use crate::prepared::PreparedScene;
 
@@ -22,34 +22,38 @@ pub(crate) fn setup_2d(
     span: SampleSpan,
 ) -> Vec<Placed<Triangle2D>> {
     let affine = view.is_orthographic();
-    setup_pieces(scene, view, span, |v| {
+    setup_pieces(scene, view, span, [GUARD_BAND; 2], |v| {
         let t = Triangle2D::setup(v, affine, view.width, view.height)?;
         Some((t, t.bounds))
     })
 }
 
-/// As [`setup_2d`], with vertices snapped to 1/256 pixel and exact edge functions.
+/// As [`setup_2d`], with vertices snapped to 1/256 pixel and exact edge
+/// functions, and a guard band as wide as fixed point allows (clipping moves
+/// edges by up to half a snapping step; hardware clips as rarely).
 pub(crate) fn setup_2d_fixed(
     scene: &PreparedScene,
     view: &View,
     span: SampleSpan,
 ) -> Vec<Placed<Triangle2DFixed>> {
     let affine = view.is_orthographic();
-    setup_pieces(scene, view, span, |v| {
+    setup_pieces(scene, view, span, fixed_guard_band(view), |v| {
         let t = Triangle2DFixed::setup(v, affine)?;
         Some((t, t.bounds))
     })
 }
 
-/// Clips, projects and fan-triangulates every drawable triangle; `make` sets up
-/// each piece and gives its pixel bounds `[min_x, min_y, max_x, max_y]`.
+/// Clips (the guard band `guard` in units of the half-extents), projects and
+/// fan-triangulates every drawable triangle; `make` sets up each piece and
+/// gives its pixel bounds `[min_x, min_y, max_x, max_y]`.
 fn setup_pieces<T: Send>(
     scene: &PreparedScene,
     view: &View,
     span: SampleSpan,
+    guard: [f32; 2],
     make: impl Fn(&[ScreenVertex; 3]) -> Option<(T, [f32; 4])> + Sync,
 ) -> Vec<Placed<T>> {
-    let planes = pipeline_planes(view);
+    let planes = pipeline_planes(view, guard);
     let affine = view.is_orthographic();
     scene
         .drawable

@@ -2,6 +2,7 @@
 
 mod aa;
 mod agreement;
+mod conformance;
 mod loaders;
 mod oracles;
 mod tie_rules;
