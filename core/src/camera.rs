@@ -3,7 +3,7 @@
 //! A [`View`] is a camera at one image size. For the planar viewports it turns
 //! pixel coordinates into rays `o(x, y) + t·d(x, y)` with `o` and `d` linear in
 //! `(x, y)`: perspective `d(x, y) = d0 + x·dx + y·dy` from the eye, orthographic
-//! `o(x, y) = o0 + x·ox + y·oy` along the view axis. Pixel centres are at
+//! `o(x, y) = eye + o0 + x·ox + y·oy` along the view axis. Pixel centres are at
 //! `(px + 0.5, py + 0.5)`, `y` growing downwards. `d · forward = 1`, so the ray
 //! parameter `t` *is* the view-axis distance `w` that the depth buffer holds.
 //! The non-planar viewports ([`SphereMap`]) give unit-length-scaled rays from the
@@ -119,7 +119,9 @@ pub struct View {
     pub dx: Vec3,
     /// Planar: `∂d/∂y`, one pixel down (orthographic: zero).
     pub dy: Vec3,
-    /// Planar: ray origin at image point `(0, 0)` (perspective: the eye).
+    /// Planar: ray origin at image point `(0, 0)` relative to the eye
+    /// (perspective: zero). Relative, so that it keeps its precision however
+    /// far from the world origin the camera is.
     pub o0: Vec3,
     /// Planar: `∂o/∂x` (perspective: zero).
     pub ox: Vec3,
@@ -175,7 +177,7 @@ impl View {
                 forward,
                 Vec3::ZERO,
                 Vec3::ZERO,
-                corner(camera.eye),
+                corner(Vec3::ZERO),
                 step_x,
                 step_y,
             ),
@@ -183,7 +185,7 @@ impl View {
                 corner(forward),
                 step_x,
                 step_y,
-                camera.eye,
+                Vec3::ZERO,
                 Vec3::ZERO,
                 Vec3::ZERO,
             ),
@@ -222,10 +224,17 @@ impl View {
         self.d0 + self.dx * x + self.dy * y
     }
 
+    /// Planar views: the ray origin for image point `(x, y)` relative to the
+    /// eye, `o0 + x·ox + y·oy`.
+    #[inline]
+    pub fn origin_offset(&self, x: f32, y: f32) -> Vec3 {
+        self.o0 + self.ox * x + self.oy * y
+    }
+
     /// Planar views: the ray origin for image point `(x, y)`.
     #[inline]
     pub fn origin(&self, x: f32, y: f32) -> Vec3 {
-        self.o0 + self.ox * x + self.oy * y
+        self.eye + self.origin_offset(x, y)
     }
 
     /// The ray through image point `(x, y)`: origin and direction, scaled so that
@@ -285,6 +294,22 @@ impl View {
         };
         let x = (px / self.half_x + 1.0) * half_w;
         let y = (1.0 - py / self.half_y) * half_h;
+        (x, y)
+    }
+
+    /// [`View::project`] in f64 (clipped polygons keep f64 until they are on
+    /// screen).
+    #[inline]
+    pub fn project_f64(&self, c: DVec3) -> (f64, f64) {
+        let half_w = f64::from(self.width) * 0.5;
+        let half_h = f64::from(self.height) * 0.5;
+        let (px, py) = if self.is_orthographic() {
+            (c.x, c.y)
+        } else {
+            (c.x / c.z, c.y / c.z)
+        };
+        let x = (px / f64::from(self.half_x) + 1.0) * half_w;
+        let y = (1.0 - py / f64::from(self.half_y)) * half_h;
         (x, y)
     }
 

@@ -6,8 +6,13 @@
 //! f32 to place edges to ~1e-4 pixel. New vertices are always interpolated from the
 //! inside endpoint towards the outside one, so two triangles that share an edge get
 //! bit-identical clipped vertices on it (no cracks along a clip line).
+//!
+//! Everything is in f64, the camera-space vertices and the polygons between the
+//! planes: a triangle 10¹³ pixels across that crosses the eye plane leaves
+//! vertices at `w = near` with `x` and `y` near 10¹³, and rounding those to f32
+//! would turn their directions `x/w` by far more than the screen.
 
-use glam::Vec3;
+use glam::DVec3;
 
 use crate::camera::View;
 
@@ -21,12 +26,12 @@ pub const MAX_CLIPPED: usize = 8;
 /// A convex polygon of at most [`MAX_CLIPPED`] camera-space vertices, no heap.
 #[derive(Clone, Copy, Debug)]
 pub struct ClipPolygon {
-    pub vertices: [Vec3; MAX_CLIPPED],
+    pub vertices: [DVec3; MAX_CLIPPED],
     pub len: usize,
 }
 
 impl ClipPolygon {
-    pub fn as_slice(&self) -> &[Vec3] {
+    pub fn as_slice(&self) -> &[DVec3] {
         &self.vertices[..self.len]
     }
 }
@@ -35,14 +40,41 @@ impl ClipPolygon {
 #[derive(Clone, Copy, Debug)]
 pub struct ClipPlane {
     /// `distance(v) = v.x·k.x + v.y·k.y + v.z·k.z − offset`.
-    pub k: Vec3,
-    pub offset: f32,
+    pub k: DVec3,
+    pub offset: f64,
+    /// The coordinate a new vertex is solved for, so that it lies on the plane
+    /// exactly (`k[axis] ≠ 0`): `z` for the near plane, `x` or `y` for the sides.
+    pub axis: usize,
 }
 
 impl ClipPlane {
+    /// The near plane `w = near`.
+    pub fn near(near: f64) -> ClipPlane {
+        ClipPlane {
+            k: DVec3::Z,
+            offset: near,
+            axis: 2,
+        }
+    }
+
     #[inline]
-    fn distance(&self, v: Vec3) -> f32 {
-        v.x * self.k.x + v.y * self.k.y + v.z * self.k.z - self.offset
+    fn distance(&self, v: DVec3) -> f64 {
+        v.dot(self.k) - self.offset
+    }
+
+    /// The point where the segment from `vin` (inside, distance `din`) to
+    /// `vout` (outside, `dout`) crosses the plane, with its `axis` coordinate
+    /// solved from the others so the point is on the plane.
+    fn crossing(&self, vin: DVec3, din: f64, vout: DVec3, dout: f64) -> DVec3 {
+        let t = din / (din - dout);
+        let mut v = (vin + (vout - vin) * t).to_array();
+        let k = self.k.to_array();
+        let rest: f64 = (0..3)
+            .filter(|&j| j != self.axis)
+            .map(|j| k[j] * v[j])
+            .sum();
+        v[self.axis] = (self.offset - rest) / k[self.axis];
+        DVec3::from(v)
     }
 }
 
@@ -64,50 +96,53 @@ pub fn fixed_guard_band(view: &View) -> [f32; 2] {
 /// of the half-extents ([`GUARD_BAND`] for f32, [`fixed_guard_band`] for fixed point).
 pub fn pipeline_planes(view: &View, guard: [f32; 2]) -> [ClipPlane; 5] {
     planes_for(
-        view.near,
-        guard[0] * view.half_x,
-        guard[1] * view.half_y,
+        f64::from(view.near),
+        f64::from(guard[0]) * f64::from(view.half_x),
+        f64::from(guard[1]) * f64::from(view.half_y),
         view.is_orthographic(),
     )
 }
 
 /// The near plane and the guard band's four planes at `x = ±gx`, `y = ±gy`
 /// (perspective: on `x/w`, `y/w`).
-fn planes_for(near: f32, gx: f32, gy: f32, orthographic: bool) -> [ClipPlane; 5] {
-    let side = |k: Vec3, g: f32| {
+fn planes_for(near: f64, gx: f64, gy: f64, orthographic: bool) -> [ClipPlane; 5] {
+    let side = |k: DVec3, g: f64| {
+        let axis = if k.x != 0.0 { 0 } else { 1 };
         if orthographic {
-            ClipPlane { k, offset: -g }
+            ClipPlane {
+                k,
+                offset: -g,
+                axis,
+            }
         } else {
             ClipPlane {
-                k: Vec3::new(k.x, k.y, g),
+                k: DVec3::new(k.x, k.y, g),
                 offset: 0.0,
+                axis,
             }
         }
     };
     [
-        ClipPlane {
-            k: Vec3::Z,
-            offset: near,
-        },
-        side(Vec3::X, gx),
-        side(-Vec3::X, gx),
-        side(Vec3::Y, gy),
-        side(-Vec3::Y, gy),
+        ClipPlane::near(near),
+        side(DVec3::X, gx),
+        side(-DVec3::X, gx),
+        side(DVec3::Y, gy),
+        side(-DVec3::Y, gy),
     ]
 }
 
 /// Clips triangle `tri` (camera space) against `planes`. Returns `None` when
 /// nothing is left, the polygon otherwise (the triangle itself when no plane cuts it).
-pub fn clip_triangle(tri: [Vec3; 3], planes: &[ClipPlane]) -> Option<ClipPolygon> {
+pub fn clip_triangle(tri: [DVec3; 3], planes: &[ClipPlane]) -> Option<ClipPolygon> {
     let mut poly = ClipPolygon {
-        vertices: [Vec3::ZERO; MAX_CLIPPED],
+        vertices: [DVec3::ZERO; MAX_CLIPPED],
         len: 3,
     };
     poly.vertices[..3].copy_from_slice(&tri);
     for plane in planes {
         let src = poly;
         let n = src.len;
-        let dist: [f32; MAX_CLIPPED] = std::array::from_fn(|i| {
+        let dist: [f64; MAX_CLIPPED] = std::array::from_fn(|i| {
             if i < n {
                 plane.distance(src.vertices[i])
             } else {
@@ -133,8 +168,7 @@ pub fn clip_triangle(tri: [Vec3; 3], planes: &[ClipPlane]) -> Option<ClipPolygon
                 } else {
                     (vj, dj, vi, di)
                 };
-                let t = din / (din - dout);
-                push(&mut poly, vin + (vout - vin) * t);
+                push(&mut poly, plane.crossing(vin, din, vout, dout));
             }
         }
         if poly.len < 3 {
@@ -145,7 +179,7 @@ pub fn clip_triangle(tri: [Vec3; 3], planes: &[ClipPlane]) -> Option<ClipPolygon
 }
 
 #[inline]
-fn push(poly: &mut ClipPolygon, v: Vec3) {
+fn push(poly: &mut ClipPolygon, v: DVec3) {
     // A convex polygon gains at most one vertex per plane; MAX_CLIPPED covers five.
     if poly.len < MAX_CLIPPED {
         poly.vertices[poly.len] = v;
@@ -159,11 +193,11 @@ mod tests {
 
     #[test]
     fn untouched_triangle_is_returned_as_is() {
-        let planes = planes_for(0.1, GUARD_BAND, GUARD_BAND, false);
+        let planes = planes_for(0.1, 2.0, 2.0, false);
         let tri = [
-            Vec3::new(0.0, 0.0, 1.0),
-            Vec3::new(0.1, 0.0, 1.0),
-            Vec3::new(0.0, 0.1, 1.0),
+            DVec3::new(0.0, 0.0, 1.0),
+            DVec3::new(0.1, 0.0, 1.0),
+            DVec3::new(0.0, 0.1, 1.0),
         ];
         let p = clip_triangle(tri, &planes).expect("visible");
         assert_eq!(p.as_slice(), &tri);
@@ -171,11 +205,11 @@ mod tests {
 
     #[test]
     fn near_plane_cuts_a_triangle_through_the_eye_plane() {
-        let planes = planes_for(0.5, GUARD_BAND, GUARD_BAND, false);
+        let planes = planes_for(0.5, 2.0, 2.0, false);
         let tri = [
-            Vec3::new(0.0, 0.0, -1.0),
-            Vec3::new(0.2, 0.0, 2.0),
-            Vec3::new(-0.2, 0.1, 2.0),
+            DVec3::new(0.0, 0.0, -1.0),
+            DVec3::new(0.2, 0.0, 2.0),
+            DVec3::new(-0.2, 0.1, 2.0),
         ];
         let p = clip_triangle(tri, &planes).expect("partly visible");
         assert_eq!(p.len, 4);
@@ -184,10 +218,10 @@ mod tests {
 
     #[test]
     fn shared_edge_clips_to_identical_vertices_in_both_orders() {
-        let planes = planes_for(0.5, GUARD_BAND, GUARD_BAND, false);
-        let (a, b) = (Vec3::new(0.1, 0.3, -0.7), Vec3::new(0.3, -0.2, 3.1));
-        let t1 = clip_triangle([a, b, Vec3::new(0.5, 0.5, 2.0)], &planes).expect("visible");
-        let t2 = clip_triangle([b, a, Vec3::new(-0.5, 0.5, 2.0)], &planes).expect("visible");
+        let planes = planes_for(0.5, 2.0, 2.0, false);
+        let (a, b) = (DVec3::new(0.1, 0.3, -0.7), DVec3::new(0.3, -0.2, 3.1));
+        let t1 = clip_triangle([a, b, DVec3::new(0.5, 0.5, 2.0)], &planes).expect("visible");
+        let t2 = clip_triangle([b, a, DVec3::new(-0.5, 0.5, 2.0)], &planes).expect("visible");
         let on_plane = |p: &ClipPolygon| {
             p.as_slice()
                 .iter()
@@ -195,8 +229,8 @@ mod tests {
                 .filter(|v| v.z < 0.5 + 1e-3)
                 .collect::<Vec<_>>()
         };
-        let shared1: Vec<Vec3> = on_plane(&t1);
-        let shared2: Vec<Vec3> = on_plane(&t2);
+        let shared1: Vec<DVec3> = on_plane(&t1);
+        let shared2: Vec<DVec3> = on_plane(&t2);
         assert!(
             shared1.iter().any(|v| shared2.contains(v)),
             "{shared1:?} vs {shared2:?}"
@@ -205,11 +239,11 @@ mod tests {
 
     #[test]
     fn triangle_behind_the_eye_vanishes() {
-        let planes = planes_for(0.1, GUARD_BAND, GUARD_BAND, false);
+        let planes = planes_for(0.1, 2.0, 2.0, false);
         let tri = [
-            Vec3::new(0.0, 0.0, -1.0),
-            Vec3::new(1.0, 0.0, -1.0),
-            Vec3::new(0.0, 1.0, -2.0),
+            DVec3::new(0.0, 0.0, -1.0),
+            DVec3::new(1.0, 0.0, -1.0),
+            DVec3::new(0.0, 1.0, -2.0),
         ];
         assert!(clip_triangle(tri, &planes).is_none());
     }

@@ -39,8 +39,9 @@ pub struct TraversalOracles {
     pub samples: SampleOracles,
 }
 
-/// Sets up a leaf triangle's edge functions for a view (f32 or f64).
-pub(crate) type Setup<T> = fn(&[Vec3; 3], &View) -> Option<T>;
+/// Sets up a leaf triangle's edge functions for a view (f32 or f64); the
+/// result may borrow both.
+pub(crate) type Setup<'a, T> = fn(&'a [Vec3; 3], &'a View) -> Option<T>;
 
 /// Per-frustum traversal state and counters.
 pub(crate) struct Traversal<'a, 't, T> {
@@ -48,7 +49,7 @@ pub(crate) struct Traversal<'a, 't, T> {
     pub view: &'a View,
     pub oracles: TraversalOracles,
     pub tile: &'t mut TileBuffer<'a>,
-    pub setup: Setup<T>,
+    pub setup: Setup<'a, T>,
     pub counters: RasterCounters,
     pub nodes_visited: u64,
     pub setups: u64,
@@ -77,7 +78,7 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
         view: &'a View,
         oracles: TraversalOracles,
         tile: &'t mut TileBuffer<'a>,
-        setup: Setup<T>,
+        setup: Setup<'a, T>,
     ) -> Self {
         Traversal {
             scene,

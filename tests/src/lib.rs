@@ -210,7 +210,7 @@ fn pixel_geometry_orthographic(
     y: f64,
 ) -> PixelGeometry {
     let (ox, oy) = (view.ox.as_dvec3(), view.oy.as_dvec3());
-    let o = view.o0.as_dvec3() + ox * x + oy * y;
+    let o = view.eye.as_dvec3() + view.o0.as_dvec3() + ox * x + oy * y;
     let dp = view.forward.as_dvec3();
     let gradient_of = |k: glam::DVec3| (k.dot(ox).powi(2) + k.dot(oy).powi(2)).sqrt();
     let mut edge_distance = f64::INFINITY;

@@ -374,7 +374,10 @@ pub(crate) fn run(
                 EdgeKind::ThreeD if view.sphere.is_some() => {
                     let mut items = setup3d::setup_curved(scene, view, span);
                     if samples.incremental {
-                        items.iter_mut().for_each(|p| p.tri.incremental = true);
+                        items
+                            .iter_mut()
+                            .flatten()
+                            .for_each(|p| p.tri.incremental = true);
                     }
                     tiles!(items)
                 }
@@ -406,13 +409,13 @@ pub(crate) fn run(
 
 /// The Fig. 7 traversal, one initial frustum per parallel work item, leaf
 /// triangles set up by `setup`.
-fn render_frusta<T: crate::edge::Coverage>(
-    scene: &PreparedScene,
-    context: &TileContext,
+fn render_frusta<'a, T: crate::edge::Coverage>(
+    scene: &'a PreparedScene,
+    context: &TileContext<'a>,
     oracles: TraversalOracles,
     fb: &mut Framebuffer,
     stats: &mut Stats,
-    setup: Setup<T>,
+    setup: Setup<'a, T>,
 ) -> Pass {
     let start = Instant::now();
     let done: Vec<_> = fb
@@ -443,17 +446,17 @@ fn render_frusta<T: crate::edge::Coverage>(
 }
 
 fn timed_tiles<T: crate::edge::Coverage + Sync>(
-    items: &[tiles::Placed<T>],
+    items: &[Option<tiles::Placed<T>>],
     fb: &mut Framebuffer,
     samples: SampleOracles,
     context: &TileContext,
     stats: &mut Stats,
     start: Instant,
 ) -> Pass {
-    stats.triangle_setups = items.len() as u64;
     stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
     let start = Instant::now();
-    let pass = rasterize_tiled(items, fb, samples, context);
+    let (pass, placed) = rasterize_tiled(items, fb, samples, context);
+    stats.triangle_setups = placed;
     let (coverage, shading) = pass.split(start.elapsed().as_secs_f64() * 1e3);
     stats.time_ms.coverage = coverage;
     stats.time_ms.shading = shading;

@@ -30,12 +30,12 @@ const BAND_ROWS: u32 = 4;
 /// rasterizers of this viewport use. Under CSAA the coverage-only positions are
 /// decided as the rasterizers decide them: each triangle a stored ray found is
 /// tested at every coverage position of the pixel.
-pub(crate) fn render_raycast<T: Coverage + Send + Sync>(
-    scene: &PreparedScene,
-    context: &TileContext,
+pub(crate) fn render_raycast<'a, T: Coverage + Send + Sync>(
+    scene: &'a PreparedScene,
+    context: &TileContext<'a>,
     fb: &mut Framebuffer,
     stats: &mut Stats,
-    setup: impl Fn(&[Vec3; 3], &View) -> Option<T> + Sync,
+    setup: impl Fn(&'a [Vec3; 3], &'a View) -> Option<T> + Sync,
 ) -> Pass {
     let view = context.view;
     // 1. Setup: the 3D edge functions of every drawable triangle for this view.

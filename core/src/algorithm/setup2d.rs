@@ -20,7 +20,7 @@ pub(crate) fn setup_2d(
     scene: &PreparedScene,
     view: &View,
     span: SampleSpan,
-) -> Vec<Placed<Triangle2D>> {
+) -> Vec<Option<Placed<Triangle2D>>> {
     let affine = view.is_orthographic();
     setup_pieces(scene, view, span, [GUARD_BAND; 2], |v| {
         let t = Triangle2D::setup(v, affine, view.width, view.height)?;
@@ -35,7 +35,7 @@ pub(crate) fn setup_2d_fixed(
     scene: &PreparedScene,
     view: &View,
     span: SampleSpan,
-) -> Vec<Placed<Triangle2DFixed>> {
+) -> Vec<Option<Placed<Triangle2DFixed>>> {
     let affine = view.is_orthographic();
     setup_pieces(scene, view, span, fixed_guard_band(view), |v| {
         let t = Triangle2DFixed::setup(v, affine)?;
@@ -52,7 +52,7 @@ fn setup_pieces<T: Send>(
     span: SampleSpan,
     guard: [f32; 2],
     make: impl Fn(&[ScreenVertex; 3]) -> Option<(T, [f32; 4])> + Sync,
-) -> Vec<Placed<T>> {
+) -> Vec<Option<Placed<T>>> {
     let planes = pipeline_planes(view, guard);
     let affine = view.is_orthographic();
     scene
@@ -61,11 +61,7 @@ fn setup_pieces<T: Send>(
         .fold(Vec::new, |mut out, &id| {
             // 1. Transform and clip.
             let p = &scene.triangles[id as usize];
-            let cam = [
-                view.to_camera(p[0]),
-                view.to_camera(p[1]),
-                view.to_camera(p[2]),
-            ];
+            let cam = p.map(|v| view.to_camera_f64(v));
             let Some(poly) = clip_triangle(cam, &planes) else {
                 return out;
             };
@@ -76,11 +72,11 @@ fn setup_pieces<T: Send>(
                 q: 0.0,
             }; crate::clip::MAX_CLIPPED];
             for (s, c) in screen.iter_mut().zip(poly.as_slice()) {
-                let (x, y) = view.project(*c);
+                let (x, y) = view.project_f64(*c);
                 *s = ScreenVertex {
-                    x,
-                    y,
-                    q: if affine { c.z } else { 1.0 / c.z },
+                    x: x as f32,
+                    y: y as f32,
+                    q: (if affine { c.z } else { 1.0 / c.z }) as f32,
                 };
             }
             // 3. Fan-triangulate and set up each piece.
@@ -92,7 +88,7 @@ fn setup_pieces<T: Send>(
                 if let Some(rect) =
                     PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height, span)
                 {
-                    out.push(Placed { tri, rect, id });
+                    out.push(Some(Placed { tri, rect, id }));
                 }
             }
             out

@@ -14,11 +14,11 @@ use crate::edge::{self, CurvedTriangle, Triangle3D, Triangle3D64};
 use crate::prepared::PreparedScene;
 
 /// Every drawable triangle with samples on screen, set up with 3D edge functions.
-pub(crate) fn setup_3d(
-    scene: &PreparedScene,
-    view: &View,
+pub(crate) fn setup_3d<'a>(
+    scene: &'a PreparedScene,
+    view: &'a View,
     span: SampleSpan,
-) -> Vec<Placed<Triangle3D>> {
+) -> Vec<Option<Placed<Triangle3D<'a>>>> {
     setup_visible(scene, view, span, Triangle3D::setup)
 }
 
@@ -27,7 +27,7 @@ pub(crate) fn setup_3d_f64(
     scene: &PreparedScene,
     view: &View,
     span: SampleSpan,
-) -> Vec<Placed<Triangle3D64>> {
+) -> Vec<Option<Placed<Triangle3D64>>> {
     setup_visible(scene, view, span, Triangle3D64::setup)
 }
 
@@ -37,35 +37,37 @@ pub(crate) fn setup_curved(
     scene: &PreparedScene,
     view: &View,
     span: SampleSpan,
-) -> Vec<Placed<CurvedTriangle>> {
+) -> Vec<Option<Placed<CurvedTriangle>>> {
     setup_visible(scene, view, span, CurvedTriangle::setup)
 }
 
 /// Every drawable triangle with samples on screen, set up for homogeneous 2D
 /// rasterization (no clipping).
-pub(crate) fn setup_homogeneous(
-    scene: &PreparedScene,
-    view: &View,
+pub(crate) fn setup_homogeneous<'a>(
+    scene: &'a PreparedScene,
+    view: &'a View,
     span: SampleSpan,
-) -> Vec<Placed<Triangle3D>> {
+) -> Vec<Option<Placed<Triangle3D<'a>>>> {
     setup_visible(scene, view, span, edge::setup_homogeneous)
 }
 
-fn setup_visible<T: Send>(
-    scene: &PreparedScene,
-    view: &View,
+fn setup_visible<'a, T: Send>(
+    scene: &'a PreparedScene,
+    view: &'a View,
     span: SampleSpan,
-    setup: impl Fn(&[Vec3; 3], &View) -> Option<T> + Sync,
-) -> Vec<Placed<T>> {
+    setup: impl Fn(&'a [Vec3; 3], &'a View) -> Option<T> + Sync,
+) -> Vec<Option<Placed<T>>> {
     // Planar views: every vertex projected once, not once per triangle using it.
     let projected = view
         .sphere
         .is_none()
         .then(|| VertexPoints::new(scene, view));
+    // One slot per drawable triangle (an exactly sized, parallel collect: no
+    // chunks to concatenate); `None` for the ones off screen or edge-on.
     scene
         .drawable
         .par_iter()
-        .filter_map(|&id| {
+        .map(|&id| {
             let p = &scene.triangles[id as usize];
             let rect = match &projected {
                 Some(points) => points.rect(scene, id, view, span),
@@ -111,13 +113,11 @@ pub(crate) fn screen_rect(p: &[Vec3; 3], view: &View, span: SampleSpan) -> Optio
         cam.into_iter()
             .for_each(|c| image_box.grow(view.project(c)));
     } else {
-        let plane = ClipPlane {
-            k: Vec3::Z,
-            offset: near_bound,
-        };
-        let poly = clip_triangle(cam, &[plane])?;
+        let cam = p.map(|v| view.to_camera_f64(v));
+        let poly = clip_triangle(cam, &[ClipPlane::near(f64::from(near_bound))])?;
         for &c in poly.as_slice() {
-            image_box.grow(view.project(c));
+            let (x, y) = view.project_f64(c);
+            image_box.grow((x as f32, y as f32));
         }
     }
     image_box.pixels(view, span)

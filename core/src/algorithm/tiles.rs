@@ -21,13 +21,14 @@ pub(crate) struct Placed<T> {
     pub id: u32,
 }
 
-/// Renders `items` into `fb`, tile by tile in parallel.
+/// Renders `items` into `fb`, tile by tile in parallel (`None` slots are
+/// triangles the setup dropped); also returns how many were placed.
 pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
-    items: &[Placed<T>],
+    items: &[Option<Placed<T>>],
     fb: &mut Framebuffer,
     oracles: SampleOracles,
     context: &TileContext,
-) -> Pass {
+) -> (Pass, u64) {
     let columns = fb.width.div_ceil(TILE) as usize;
     let rows = fb.height.div_ceil(TILE) as usize;
     let tile_count = columns * rows;
@@ -40,7 +41,9 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
 
     // 1. Counting sort of item indices by tile.
     let mut offsets = vec![0u32; tile_count + 1];
-    for item in items {
+    let mut placed = 0;
+    for item in items.iter().flatten() {
+        placed += 1;
         for t in tiles_of(&item.rect) {
             offsets[t + 1] += 1;
         }
@@ -51,6 +54,7 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
     let mut fill = offsets.clone();
     let mut members = vec![0u32; offsets[tile_count] as usize];
     for (k, item) in items.iter().enumerate() {
+        let Some(item) = item else { continue };
         for t in tiles_of(&item.rect) {
             members[fill[t] as usize] = k as u32;
             fill[t] += 1;
@@ -69,7 +73,10 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
                 context.run_tile(cache, rect, |tile| {
                     let mut counters = RasterCounters::default();
                     for &k in &members[offsets[t] as usize..offsets[t + 1] as usize] {
-                        let item = &items[k as usize];
+                        // Only placed slots were sorted into tiles.
+                        let Some(item) = &items[k as usize] else {
+                            continue;
+                        };
                         // Non-empty: the item was sorted into this tile by its rect.
                         if let Some(clip) = item.rect.intersect(tile.rect()) {
                             raster_triangle(tile, &item.tri, item.id, clip, oracles, &mut counters);
@@ -84,5 +91,5 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
     for finished in done {
         pass.store(fb, &finished);
     }
-    pass
+    (pass, placed)
 }

@@ -1,22 +1,38 @@
 //! 3D edge functions (paper §3.2–3.4).
 //!
 //! For eye `e` and an edge `(a, b)` the edge normal is built from the edge midpoint,
-//! `n = (e − (a+b)/2) × (a − b)` (§3.4 "Numerics"): the two triangles that share an
-//! edge get bitwise negated normals in f32, so they split every sample on it.
-//! With a sample direction `d(x, y) = d0 + x·dx + y·dy` the edge function is
+//! `n = (e − (a+b)/2) × (a − b)` (§3.4 "Numerics"), with every vertex taken
+//! relative to the eye first: the two triangles that share an edge get bitwise
+//! negated normals in f32, so they split every sample on it. With a sample
+//! direction `d(x, y) = d0 + x·dx + y·dy` the edge function is
 //! `V(x, y) = n·d = A + x·B + y·C` with `A = n·d0`, `B = n·dx`, `C = n·dy`.
 //!
 //! Orthographic views (§3.3) cast parallel rays `o(x, y) + t·d_p`; the edge
 //! normal is `n = d_p × (a − b)` and the edge function `V = n·(m − o(x, y))`
 //! with `m` the edge midpoint — the same triple product `[o − m, a − b, d]` as
 //! the perspective one with the eye replaced by the ray origin, again linear.
+//!
+//! **Exact decisions.** Shared edges alone do not make a mesh watertight: at a
+//! vertex that lies on a sample's ray every edge through it should be exactly
+//! zero, and rounding makes the f32 values small numbers of arbitrary sign, so
+//! a sample there could land in two triangles of a fan or in none. So every
+//! edge carries a certified bound on how far its f32 value can be from the
+//! exact one (`tolerance`); beyond it the f32 sign is the exact sign, and within
+//! it the sign is computed exactly ([`super::exact`]) from the same f32 inputs,
+//! an exact zero going to the §3.4 tie rule on exact derivatives. Every sample
+//! is then decided exactly — consistently across the whole mesh — while almost
+//! all of them take the f32 path (samples within ~10⁻⁴ pixel of an edge do not).
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 use wide::f32x8;
 
-use super::{BlockTest, Coverage, LinearEdges, linear_classify, linear_sample, owns_tie};
+use super::exact::{self, Expansion};
+use super::{BlockTest, Coverage};
 use crate::camera::View;
+
+/// Unit roundoff of f32.
+pub(crate) const EPS: f32 = f32::EPSILON * 0.5;
 
 /// A triangle set up for 3D rasterization against one view: per edge `i`
 /// (opposite vertex `i`) the coefficients of `E_i(x, y) = A_i + x·B_i + y·C_i`,
@@ -33,7 +49,7 @@ use crate::camera::View;
 /// through [`Coverage::sample`] on these coefficients, in one fixed operation
 /// order with no fused multiply-add, so they agree bit for bit.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Triangle3D {
+pub struct Triangle3D<'a> {
     pub a: [f32; 3],
     pub b: [f32; 3],
     pub c: [f32; 3],
@@ -42,111 +58,244 @@ pub struct Triangle3D {
     pub volume: [f32; 3],
     /// `N·d(x, y) = nd[0] + x·nd[1] + y·nd[2]`, sign-normalised like the edges.
     pub nd: [f32; 3],
-    /// Per edge: does it own samples exactly on it (the §3.4 tie rule)?
-    pub owns: [bool; 3],
     /// View-axis distance of the nearest and farthest vertex: every sample's `w`
     /// is clamped into this range (exact in real arithmetic, and it gives early-z
     /// and occlusion culling a bound no rounding can undercut).
     pub w_range: [f32; 2],
     /// Samples nearer than this are rejected.
     pub near: f32,
-    /// Per edge: a bound on the rounding error of [`LinearEdges::edge_values`] anywhere
-    /// on the image (for conservative binning).
-    pub error: [f32; 3],
+    /// Per edge: a certified bound on how far [`Triangle3D::edge_values`] can be
+    /// from the exact edge function anywhere on the image; within it the exact
+    /// sign decides.
+    pub tolerance: [f32; 3],
+    /// The f32 geometry the exact decisions are made on.
+    exact: ExactEdges<'a>,
 }
 
-/// The midpoint edge normal `(e − (a+b)/2) × (a − b)` of §3.4. Swapping `a` and `b`
-/// negates the result exactly: `a + b` is commutative and `a − b = −(b − a)`.
+/// Which exact edge functions a [`Triangle3D`] stands for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ExactForm {
+    /// `det[a − e, b − e, d(x, y)]` (perspective, §3.2).
+    Perspective,
+    /// `det[a − o(x, y), b − o(x, y), d_p]` (orthographic, §3.3).
+    Orthographic,
+    /// `det[h_a, h_b, (x, y, 1)]` on homogeneous pixel coordinates (Olano–Greer).
+    Homogeneous,
+}
+
+/// What the exact decisions need: the vertices (as the setup rounded them,
+/// recomputed on demand from the scene's own), the view, and the orientation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct ExactEdges<'a> {
+    form: ExactForm,
+    vertices: &'a [Vec3; 3],
+    view: &'a View,
+    /// The edges were negated to make the inside positive.
+    negated: bool,
+}
+
+impl<'a> ExactEdges<'a> {
+    pub(crate) fn new(
+        form: ExactForm,
+        vertices: &'a [Vec3; 3],
+        view: &'a View,
+        negated: bool,
+    ) -> ExactEdges<'a> {
+        ExactEdges {
+            form,
+            vertices,
+            view,
+            negated,
+        }
+    }
+}
+
+/// The midpoint edge normal `(e − (a+b)/2) × (a − b)` of §3.4 with `a` and `b`
+/// relative to the eye (`e = 0`). Swapping `a` and `b` negates the result
+/// exactly: `a + b` is commutative and `a − b = −(b − a)`.
 #[inline]
-pub fn edge_normal(eye: Vec3, a: Vec3, b: Vec3) -> Vec3 {
-    let mid = (a + b) * 0.5;
-    (eye - mid).cross(a - b)
+pub fn edge_normal(a: Vec3, b: Vec3) -> Vec3 {
+    (-(a + b) * 0.5).cross(a - b)
+}
+
+/// `|a| ⊗ |b|`: per component the sum of the magnitudes of the two products a
+/// cross-product component subtracts (what bounds its rounding).
+#[inline]
+pub(crate) fn abs_cross(a: Vec3, b: Vec3) -> Vec3 {
+    let (a, b) = (a.abs(), b.abs());
+    Vec3::new(
+        a.y * b.z + a.z * b.y,
+        a.z * b.x + a.x * b.z,
+        a.x * b.y + a.y * b.x,
+    )
+}
+
+/// Vertices beyond this many units make setup products overflow f32.
+const SCALE_ABOVE: f32 = (1u64 << 32) as f32;
+
+/// `c` scaled by a power of two `2⁻ᵏ` so that its largest coordinate is about 1
+/// when it exceeds [`SCALE_ABOVE`] (unscaled otherwise), and `2ᵏ`. Exact: every
+/// product and sum of the setup scales with it, rounding alike, so the shared
+/// edges of neighbours stay exactly negated whatever their scales.
+pub(crate) fn scaled(c: [Vec3; 3]) -> ([Vec3; 3], f32) {
+    let max = c
+        .iter()
+        .map(|v| v.abs().max_element())
+        .fold(0.0f32, f32::max);
+    if !(max > SCALE_ABOVE && max.is_finite()) {
+        return (c, 1.0);
+    }
+    let k = max.log2().ceil() as i32;
+    let down = 2f32.powi(-k);
+    (c.map(|v| v * down), 2f32.powi(k))
 }
 
 /// Linear functions of the image point, `k[0] + x·k[1] + y·k[2]`.
 pub type Linear = [f32; 3];
 
-impl Triangle3D {
+/// The image's largest sample coordinates (the pattern's offsets stay within
+/// one pixel of the image).
+#[inline]
+pub(crate) fn image_extent(view: &View) -> (f32, f32) {
+    (view.width as f32 + 1.0, view.height as f32 + 1.0)
+}
+
+impl<'a> Triangle3D<'a> {
     /// Paper §3.2 setup: three edge normals, their derivatives along the sample
     /// generator, and the triangle's volume as seen from the eye. `None` when the
     /// triangle is seen exactly edge-on (`D = 0`) or the values are not finite.
     #[inline]
-    pub fn setup(p: &[Vec3; 3], view: &View) -> Option<Triangle3D> {
+    pub fn setup(p: &'a [Vec3; 3], view: &'a View) -> Option<Triangle3D<'a>> {
+        // 1. Vertices relative to the eye (exact for geometry near the camera,
+        //    however far both are from the world origin).
+        let c = p.map(|v| v - view.eye);
         if view.is_orthographic() {
-            return Self::setup_orthographic(p, view);
+            return Self::setup_orthographic(p, &c, view);
         }
-        let eye = view.eye;
-        // 1. Total volume D = N · (p0 − e) with the geometric normal N; its sign is
-        //    the side the eye sees, and it orients the edge functions.
-        let normal = (p[1] - p[0]).cross(p[2] - p[0]);
-        let d = normal.dot(p[0] - eye);
-        if d == 0.0 || !d.is_finite() {
-            return None;
-        }
-        let sign = if d > 0.0 { 1.0 } else { -1.0 };
+        let w = c.map(|v| v.dot(view.forward));
+        // 2. Vertices 10¹² away would overflow D's products (~|c|³): scaled by a
+        //    power of two, which is exact and changes no sign.
+        let (c, scale) = scaled(c);
+        // 3. Total volume D = N · (p0 − e) with the geometric normal N; its sign is
+        //    the side the eye sees, and it orients the edge functions. Near zero
+        //    the exact sign decides.
+        let (e1, e2) = (c[1] - c[0], c[2] - c[0]);
+        let normal = e1.cross(e2);
+        let d = normal.dot(c[0]);
+        let d_bound = 16.0 * EPS * abs_cross(e1, e2).dot(c[0].abs());
+        let positive = orientation(d, d_bound, || {
+            let v = c.map(|v| v.as_dvec3().to_array());
+            exact::dot(&exact::cross(v[1], v[2]), v[0]).signum()
+        })?;
+        let sign = if positive { 1.0 } else { -1.0 };
         let along = |n: Vec3| [n.dot(view.d0), n.dot(view.dx), n.dot(view.dy)];
-        // 2. Edge i is opposite vertex i: (p[i+1], p[i+2]).
-        let edges =
-            [0, 1, 2].map(|i| along(edge_normal(eye, p[(i + 1) % 3], p[(i + 2) % 3]) * sign));
-        let w = p.map(|v| (v - eye).dot(view.forward));
-        Triangle3D::from_linear(edges, along(normal * sign), [d.abs(), 0.0, 0.0], w, view)
+        // 4. Edge i is opposite vertex i: (p[i+1], p[i+2]); its f32 error is at
+        //    most 8ε of |m| ⊗ |u| along the largest sample direction.
+        let (x_max, y_max) = image_extent(view);
+        let d_abs = view.d0.abs() + view.dx.abs() * x_max + view.dy.abs() * y_max;
+        let mut coefficient_error = [0.0; 3];
+        let edges = [0, 1, 2].map(|i| {
+            let (a, b) = (c[(i + 1) % 3], c[(i + 2) % 3]);
+            coefficient_error[i] = 8.0 * EPS * abs_cross((a + b) * 0.5, a - b).dot(d_abs);
+            along(edge_normal(a, b) * sign)
+        });
+        // w = |D|/(N·d) is homogeneous of degree 1 in the vertices: undo the scale.
+        Triangle3D::from_linear(
+            edges,
+            along(normal * sign),
+            [d.abs() * scale, 0.0, 0.0],
+            w,
+            view,
+            coefficient_error,
+            ExactEdges::new(ExactForm::Perspective, p, view, !positive),
+        )
     }
 
     /// Paper §3.3: orthographic setup, `n_i = d_p × (p_{i+1} − p_{i+2})` and
     /// `V_i = n_i · (m_i − o(x, y))`; the depth `w = N·(p0 − o(x, y)) / (N·d_p)`.
-    /// `None` when the triangle is seen edge-on (`N·d_p = 0`).
-    pub fn setup_orthographic(p: &[Vec3; 3], view: &View) -> Option<Triangle3D> {
+    /// `c` are the vertices relative to the eye. `None` when the triangle is
+    /// seen edge-on (`N·d_p = 0`).
+    fn setup_orthographic(
+        p: &'a [Vec3; 3],
+        c: &[Vec3; 3],
+        view: &'a View,
+    ) -> Option<Triangle3D<'a>> {
         let dp = view.forward;
-        let normal = (p[1] - p[0]).cross(p[2] - p[0]);
+        let w = c.map(|v| v.dot(dp));
+        // Far vertices and the ray origins scaled together by a power of two
+        // (see [`scaled`]): the edges are of degree 2 in them, the volume 3.
+        let (c, scale) = scaled(*c);
+        let down = 1.0 / scale;
+        let (o0, ox, oy) = (view.o0 * down, view.ox * down, view.oy * down);
+        let (e1, e2) = (c[1] - c[0], c[2] - c[0]);
+        let normal = e1.cross(e2);
         let facing = normal.dot(dp);
-        if facing == 0.0 || !facing.is_finite() {
-            return None;
-        }
-        let sign = if facing > 0.0 { 1.0 } else { -1.0 };
-        // k·(q − o(x, y)) = k·(q − o0) − x·k·ox − y·k·oy.
-        let toward = |k: Vec3, q: Vec3| [k.dot(q - view.o0), -k.dot(view.ox), -k.dot(view.oy)];
+        let facing_bound = 16.0 * EPS * abs_cross(e1, e2).dot(dp.abs());
+        let positive = orientation(facing, facing_bound, || {
+            let v = c.map(|v| v.as_dvec3().to_array());
+            let n = exact::cross_exact(
+                &exact::difference(v[1], v[0]),
+                &exact::difference(v[2], v[0]),
+            );
+            exact::dot(&n, dp.as_dvec3().to_array()).signum()
+        })?;
+        let sign = if positive { 1.0 } else { -1.0 };
+        // k·(q − o(x, y)) = k·(q − o0) − x·k·ox − y·k·oy, all relative to the eye.
+        let toward = |k: Vec3, q: Vec3| [k.dot(q - o0), -k.dot(ox), -k.dot(oy)];
+        let (x_max, y_max) = image_extent(view);
+        let o_abs = o0.abs() + ox.abs() * x_max + oy.abs() * y_max;
+        let mut coefficient_error = [0.0; 3];
         let edges = [0, 1, 2].map(|i| {
-            let (a, b) = (p[(i + 1) % 3], p[(i + 2) % 3]);
-            toward(dp.cross(a - b) * sign, (a + b) * 0.5)
+            let (a, b) = (c[(i + 1) % 3], c[(i + 2) % 3]);
+            let q = (a + b) * 0.5;
+            coefficient_error[i] = 8.0 * EPS * abs_cross(dp, a - b).dot(q.abs() + o_abs);
+            toward(dp.cross(a - b) * sign, q)
         });
-        let w = p.map(|v| (v - view.eye).dot(dp));
         Triangle3D::from_linear(
             edges,
             [facing.abs(), 0.0, 0.0],
-            toward(normal * sign, p[0]),
+            toward(normal * sign, c[0]).map(|v| v * scale),
             w,
             view,
+            coefficient_error,
+            ExactEdges::new(ExactForm::Orthographic, p, view, !positive),
         )
     }
 
     /// Assembles a triangle from its three sign-normalised edge functions, the
-    /// depth as a ratio of linear functions `w = volume / nd`, and its vertices'
-    /// `w`: derives the tie rule and the error bounds. `None` on non-finite values.
-    pub fn from_linear(
+    /// depth as a ratio of linear functions `w = volume / nd`, its vertices' `w`,
+    /// the bound on each edge's coefficient error over the image, and the exact
+    /// edges it stands for; adds the evaluation's rounding to the tolerance.
+    /// `None` on non-finite values.
+    pub(crate) fn from_linear(
         edges: [Linear; 3],
         nd: Linear,
         volume: Linear,
         vertex_w: [f32; 3],
         view: &View,
-    ) -> Option<Triangle3D> {
-        let (x_max, y_max) = (view.width as f32, view.height as f32);
+        coefficient_error: [f32; 3],
+        exact: ExactEdges<'a>,
+    ) -> Option<Triangle3D<'a>> {
+        let (x_max, y_max) = image_extent(view);
         let t = Triangle3D {
             a: edges.map(|e| e[0]),
             b: edges.map(|e| e[1]),
             c: edges.map(|e| e[2]),
             nd,
             volume,
-            owns: edges.map(|e| owns_tie(e[1], e[2])),
             w_range: [
                 vertex_w[0].min(vertex_w[1]).min(vertex_w[2]),
                 vertex_w[0].max(vertex_w[1]).max(vertex_w[2]),
             ],
             near: view.near,
-            // (A + x·B) + y·C rounds four times, each by at most 2⁻²⁴ of the sum of
-            // the terms' magnitudes; 2⁻²⁰ leaves a factor-4 margin.
-            error: edges.map(|e| {
-                (e[0].abs() + x_max * e[1].abs() + y_max * e[2].abs()) * (1.0 / (1 << 20) as f32)
+            // (A + x·B) + y·C rounds four times, each by at most ε of the sum of
+            // the terms' magnitudes; both bounds doubled for margin.
+            tolerance: std::array::from_fn(|i| {
+                let e = edges[i];
+                let evaluation = 4.0 * EPS * (e[0].abs() + x_max * e[1].abs() + y_max * e[2].abs());
+                2.0 * (coefficient_error[i] + evaluation)
             }),
+            exact,
         };
         let finite = edges
             .iter()
@@ -154,15 +303,14 @@ impl Triangle3D {
             .chain(&nd)
             .chain(&volume)
             .chain(&t.w_range)
+            .chain(&t.tolerance)
             .all(|v| v.is_finite());
         finite.then_some(t)
     }
-}
 
-impl LinearEdges for Triangle3D {
     /// The three edge values at image point `(x, y)`: `(A + x·B) + y·C`.
     #[inline(always)]
-    fn edge_values(&self, x: f32, y: f32) -> [f32; 3] {
+    pub fn edge_values(&self, x: f32, y: f32) -> [f32; 3] {
         [
             self.a[0] + x * self.b[0] + y * self.c[0],
             self.a[1] + x * self.b[1] + y * self.c[1],
@@ -170,14 +318,24 @@ impl LinearEdges for Triangle3D {
         ]
     }
 
+    /// Is the sample at `(x, y)` with f32 edge values `e` inside all three
+    /// edges? The f32 sign where it is certain, the exact one where it is not.
     #[inline(always)]
-    fn owns(&self) -> [bool; 3] {
-        self.owns
+    fn inside(&self, e: [f32; 3], x: f32, y: f32) -> bool {
+        (0..3).all(|i| {
+            if e[i] > self.tolerance[i] {
+                true
+            } else if e[i] < -self.tolerance[i] {
+                false
+            } else {
+                self.exact.inside(i, x, y)
+            }
+        })
     }
 
     /// `w = |D| / (N·d)`, clamped to the vertices' range; `None` below `near`.
     #[inline(always)]
-    fn depth(&self, _edges: [f32; 3], x: f32, y: f32) -> Option<f32> {
+    fn depth(&self, x: f32, y: f32) -> Option<f32> {
         let facing = self.nd[0] + x * self.nd[1] + y * self.nd[2];
         if facing <= 0.0 {
             return None;
@@ -187,40 +345,214 @@ impl LinearEdges for Triangle3D {
         let w = (volume / facing).max(self.w_range[0]).min(self.w_range[1]);
         (w >= self.near).then_some(w)
     }
+}
 
-    fn edge_error(&self) -> [f32; 3] {
-        self.error
+/// The orientation of a triangle from its f32 determinant `d` with error at
+/// most `bound`, the exact sign (`exact`) deciding within it; `None` when the
+/// exact determinant is zero or `d` is not finite.
+#[inline]
+pub(crate) fn orientation(d: f32, bound: f32, exact: impl FnOnce() -> i32) -> Option<bool> {
+    if !(d.is_finite() && bound.is_finite()) {
+        return None;
+    }
+    if d > bound {
+        Some(true)
+    } else if d < -bound {
+        Some(false)
+    } else {
+        match exact() {
+            0 => None,
+            s => Some(s > 0),
+        }
+    }
+}
+
+impl ExactEdges<'_> {
+    /// The vertices as the setup saw them: relative to the eye (3D), or in
+    /// homogeneous pixel coordinates; exact in f64.
+    fn points(&self) -> [[f64; 3]; 3] {
+        let view = self.view;
+        self.vertices.map(|p| {
+            let v = match self.form {
+                ExactForm::Homogeneous => super::homogeneous::homogeneous_point(p, view),
+                _ => p - view.eye,
+            };
+            v.as_dvec3().to_array()
+        })
+    }
+
+    /// Edge `i`'s exact function at `(x, y)` and its exact derivatives along
+    /// `x` and `y`, oriented so the inside is positive.
+    fn value(&self, i: usize, x: f32, y: f32, derivatives: bool) -> (Expansion, [Expansion; 2]) {
+        let p = self.points();
+        let (a, b) = (p[(i + 1) % 3], p[(i + 2) % 3]);
+        let v3 = |v: Vec3| v.as_dvec3().to_array();
+        let view = self.view;
+        let (x, y) = (f64::from(x), f64::from(y));
+        let (value, dx, dy) = match self.form {
+            ExactForm::Perspective => {
+                let n = exact::cross(a, b);
+                let d = exact::affine(v3(view.d0), x, v3(view.dx), y, v3(view.dy));
+                let deriv = |k: Vec3| {
+                    if derivatives {
+                        exact::dot(&n, v3(k))
+                    } else {
+                        Expansion::default()
+                    }
+                };
+                (exact::dot_exact(&n, &d), deriv(view.dx), deriv(view.dy))
+            }
+            ExactForm::Orthographic => {
+                // det[a, b, d_p] + det[o(x, y), a − b, d_p]
+                let dp = v3(view.forward);
+                let w = exact::cross_exact(&exact::difference(a, b), &exact::vector(dp));
+                let o = exact::affine(v3(view.o0), x, v3(view.ox), y, v3(view.oy));
+                let value = exact::dot(&exact::cross(a, b), dp).add(&exact::dot_exact(&o, &w));
+                let deriv = |k: Vec3| {
+                    if derivatives {
+                        exact::dot(&w, v3(k))
+                    } else {
+                        Expansion::default()
+                    }
+                };
+                (value, deriv(view.ox), deriv(view.oy))
+            }
+            ExactForm::Homogeneous => {
+                let n = exact::cross(a, b);
+                let value = exact::dot(&n, [x, y, 1.0]);
+                (value, n[0].clone(), n[1].clone())
+            }
+        };
+        if self.negated {
+            let neg = |e: Expansion| Expansion::default().sub(&e);
+            (neg(value), [neg(dx), neg(dy)])
+        } else {
+            (value, [dx, dy])
+        }
+    }
+
+    /// Edge `i`'s value at `(x, y)` in f64 from the same inputs, oriented,
+    /// with a rigorous bound on its error (products of two f32 are exact in
+    /// f64; every other operation rounds by at most ε₆₄ = 2⁻⁵³ of its
+    /// operands' magnitudes, bounded here with a factor-2 margin).
+    fn value_f64(&self, i: usize, x: f32, y: f32) -> (f64, f64) {
+        const EPS64: f64 = f64::EPSILON * 0.5;
+        let p = self.points();
+        let (a, b) = (DVec3::from(p[(i + 1) % 3]), DVec3::from(p[(i + 2) % 3]));
+        let view = self.view;
+        let (x, y) = (f64::from(x), f64::from(y));
+        let abs_cross = |a: DVec3, b: DVec3| {
+            let (a, b) = (a.abs(), b.abs());
+            DVec3::new(
+                a.y * b.z + a.z * b.y,
+                a.z * b.x + a.x * b.z,
+                a.x * b.y + a.y * b.x,
+            )
+        };
+        let affine = |o: Vec3, dx: Vec3, dy: Vec3| {
+            let (o, dx, dy) = (o.as_dvec3(), dx.as_dvec3(), dy.as_dvec3());
+            (
+                (o + dx * x) + dy * y,
+                o.abs() + (dx * x).abs() + (dy * y).abs(),
+            )
+        };
+        let (value, bound) = match self.form {
+            ExactForm::Perspective => {
+                let (d, d_abs) = affine(view.d0, view.dx, view.dy);
+                (a.cross(b).dot(d), 16.0 * EPS64 * abs_cross(a, b).dot(d_abs))
+            }
+            ExactForm::Orthographic => {
+                // det[a, b, d_p] + det[o(x, y), a − b, d_p]
+                let dp = view.forward.as_dvec3();
+                let (o, o_abs) = affine(view.o0, view.ox, view.oy);
+                let u = a - b;
+                let value = a.cross(b).dot(dp) + o.dot(u.cross(dp));
+                let bound = abs_cross(a, b).dot(dp.abs()) + abs_cross(u, dp).dot(o_abs);
+                (value, 32.0 * EPS64 * bound)
+            }
+            ExactForm::Homogeneous => {
+                let q = DVec3::new(x, y, 1.0);
+                (
+                    a.cross(b).dot(q),
+                    16.0 * EPS64 * abs_cross(a, b).dot(q.abs()),
+                )
+            }
+        };
+        (if self.negated { -value } else { value }, bound)
+    }
+
+    /// Is `(x, y)` inside edge `i`, exactly: a positive value, or zero and
+    /// owning the tie (paper §3.4, on exact derivatives). The f64 value
+    /// decides wherever it is certain (all but near-exact zeros), exact
+    /// expansion arithmetic elsewhere.
+    #[cold]
+    fn inside(&self, i: usize, x: f32, y: f32) -> bool {
+        let (v, bound) = self.value_f64(i, x, y);
+        if v > bound {
+            return true;
+        }
+        if v < -bound {
+            return false;
+        }
+        let (value, _) = self.value(i, x, y, false);
+        match value.signum() {
+            1 => true,
+            -1 => false,
+            _ => {
+                let (_, [dx, dy]) = self.value(i, x, y, true);
+                dx.signum() > 0 || (dx.signum() == 0 && dy.signum() > 0)
+            }
+        }
     }
 }
 
 /// The 8-lane forms of the scalar operations (no fused multiply-add, the same
 /// operation order, so every lane rounds as [`Coverage::sample`] does).
-impl Triangle3D {
+impl Triangle3D<'_> {
     #[inline(always)]
     fn sample_lanes(&self, x: f32x8, y: f32x8) -> (u8, [f32; 8]) {
         let facing = self.facing_lanes(x, y);
-        let inside = self.edges_lanes(x, y) & facing.simd_gt(f32x8::ZERO);
-        let mask = inside.to_bitmask() as u8;
-        if mask == 0 {
+        let inside = self.edges_lanes(x, y) & facing.simd_gt(f32x8::ZERO).to_bitmask() as u8;
+        if inside == 0 {
             return (0, [0.0; 8]);
         }
-        self.depth_lanes(x, y, facing, mask)
+        self.depth_lanes(x, y, facing, inside)
     }
 
-    /// All-ones lanes where the three edges (with the tie rule) hold the point.
+    /// The lanes whose points are inside all three edges: the f32 signs where
+    /// they are certain, the exact ones (lane by lane) where they are not.
     #[inline(always)]
-    fn edges_lanes(&self, x: f32x8, y: f32x8) -> f32x8 {
-        let zero = f32x8::ZERO;
-        let mut inside = f32x8::from([f32::from_bits(u32::MAX); 8]);
+    fn edges_lanes(&self, x: f32x8, y: f32x8) -> u8 {
+        let mut certain_in = f32x8::from([f32::from_bits(u32::MAX); 8]);
+        let mut certain_out = f32x8::ZERO.simd_ne(f32x8::ZERO);
         for k in 0..3 {
             let e =
                 f32x8::splat(self.a[k]) + x * f32x8::splat(self.b[k]) + y * f32x8::splat(self.c[k]);
-            let on_edge = if self.owns[k] {
-                e.simd_eq(zero)
-            } else {
-                zero.simd_ne(zero)
-            };
-            inside &= e.simd_gt(zero) | on_edge;
+            let tolerance = f32x8::splat(self.tolerance[k]);
+            certain_in &= e.simd_gt(tolerance);
+            certain_out |= e.simd_lt(-tolerance);
+        }
+        let inside = certain_in.to_bitmask() as u8;
+        let undecided = !(inside | certain_out.to_bitmask() as u8);
+        if undecided == 0 {
+            inside
+        } else {
+            inside | self.decide_lanes(undecided, x, y)
+        }
+    }
+
+    /// The undecided lanes one by one, as [`Coverage::sample`] decides them
+    /// (the scalar edge values round exactly as the lanes do).
+    #[cold]
+    fn decide_lanes(&self, mut undecided: u8, x: f32x8, y: f32x8) -> u8 {
+        let (xs, ys) = (x.to_array(), y.to_array());
+        let mut inside = 0;
+        while undecided != 0 {
+            let l = undecided.trailing_zeros() as usize;
+            undecided &= undecided - 1;
+            if self.inside(self.edge_values(xs[l], ys[l]), xs[l], ys[l]) {
+                inside |= 1 << l;
+            }
         }
         inside
     }
@@ -244,23 +576,47 @@ impl Triangle3D {
     }
 }
 
-impl Coverage for Triangle3D {
+impl Coverage for Triangle3D<'_> {
     #[inline(always)]
     fn sample(&self, x: f32, y: f32) -> Option<f32> {
-        linear_sample(self, x, y)
+        if self.inside(self.edge_values(x, y), x, y) {
+            self.depth(x, y)
+        } else {
+            None
+        }
     }
 
     #[inline(always)]
     fn depth_inside(&self, x: f32, y: f32) -> Option<f32> {
-        self.depth(self.edge_values(x, y), x, y)
+        self.depth(x, y)
     }
 
+    /// Corner values against the tolerance: outside when some edge is below
+    /// `−tolerance` at all four (so exactly outside everywhere in the block),
+    /// inside when every edge is above three tolerances at all four (so above
+    /// one at every sample, where the f32 sign decides) — paper §3.1, "binning".
     fn classify_block(&self, x0: f32, y0: f32, x1: f32, y1: f32) -> BlockTest {
-        linear_classify(self, x0, y0, x1, y1)
+        let mut lo = [f32::INFINITY; 3];
+        let mut hi = [f32::NEG_INFINITY; 3];
+        for (x, y) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1)] {
+            let e = self.edge_values(x, y);
+            for k in 0..3 {
+                lo[k] = lo[k].min(e[k]);
+                hi[k] = hi[k].max(e[k]);
+            }
+        }
+        let t = self.tolerance;
+        if (0..3).any(|k| hi[k] < -t[k]) {
+            BlockTest::Outside
+        } else if (0..3).all(|k| lo[k] > 3.0 * t[k]) {
+            BlockTest::Inside
+        } else {
+            BlockTest::Partial
+        }
     }
 
     /// Eight samples side by side (8 lanes, `wide`): the scalar operations of
-    /// [`LinearEdges::edge_values`], the tie rule and [`LinearEdges::depth`], lane by lane.
+    /// [`Triangle3D::edge_values`], the decision and the depth, lane by lane.
     #[inline(always)]
     fn sample8(&self, x0: f32, y: f32) -> (u8, [f32; 8]) {
         let x = f32x8::splat(x0) + f32x8::from([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
@@ -281,10 +637,8 @@ impl Coverage for Triangle3D {
         let volume = f32x8::splat(self.volume[0])
             + x * f32x8::splat(self.volume[1])
             + y * f32x8::splat(self.volume[2]);
-        let inside = self.edges_lanes(x, y)
-            & facing.simd_gt(f32x8::ZERO)
-            & volume.simd_ge(facing * f32x8::splat(self.near));
-        inside.to_bitmask() as u8
+        let front = facing.simd_gt(f32x8::ZERO) & volume.simd_ge(facing * f32x8::splat(self.near));
+        self.edges_lanes(x, y) & front.to_bitmask() as u8
     }
 
     #[inline(always)]

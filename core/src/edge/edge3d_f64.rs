@@ -49,11 +49,7 @@ impl Triangle3D64 {
         let w = c.map(|v| v.dot(forward));
         let (edges, nd, volume) = if view.is_orthographic() {
             // k·(q − o(x, y)) with o(x, y) − eye = (o0 − eye) + x·ox + y·oy.
-            let (o0, ox, oy) = (
-                view.o0.as_dvec3() - eye,
-                view.ox.as_dvec3(),
-                view.oy.as_dvec3(),
-            );
+            let (o0, ox, oy) = (view.o0.as_dvec3(), view.ox.as_dvec3(), view.oy.as_dvec3());
             let facing = normal.dot(forward);
             if facing == 0.0 || !facing.is_finite() {
                 return None;

@@ -12,25 +12,34 @@
 use glam::Vec3;
 
 use super::Triangle3D;
+use super::edge3d::{EPS, ExactEdges, ExactForm, abs_cross, image_extent, orientation, scaled};
+use super::exact;
 use crate::camera::View;
+
+/// A vertex in homogeneous pixel coordinates `(X, Y, W)`, `x = X/W`
+/// (orthographic: `W = 1`).
+pub(crate) fn homogeneous_point(p: Vec3, view: &View) -> Vec3 {
+    let (half_w, half_h) = (view.width as f32 * 0.5, view.height as f32 * 0.5);
+    let c = view.to_camera(p);
+    let w = if view.is_orthographic() { 1.0 } else { c.z };
+    Vec3::new(
+        (c.x / view.half_x + w) * half_w,
+        (w - c.y / view.half_y) * half_h,
+        w,
+    )
+}
 
 /// Setup of Fig. 10 (middle): transform, three cross products, determinant.
 /// `None` when the determinant is zero (degenerate or seen edge-on).
 /// Orthographic views have `W = 1` at every vertex, and `w` is interpolated
 /// linearly: `w = Σ w_i·E_i / ΣE_i`.
-pub fn setup_homogeneous(p: &[Vec3; 3], view: &View) -> Option<Triangle3D> {
+pub fn setup_homogeneous<'a>(p: &'a [Vec3; 3], view: &'a View) -> Option<Triangle3D<'a>> {
     // 1. Camera space → homogeneous pixel coordinates (X, Y, W), x = X/W.
-    let (half_w, half_h) = (view.width as f32 * 0.5, view.height as f32 * 0.5);
     let orthographic = view.is_orthographic();
     let cam = p.map(|v| view.to_camera(v));
-    let h = cam.map(|c| {
-        let w = if orthographic { 1.0 } else { c.z };
-        Vec3::new(
-            (c.x / view.half_x + w) * half_w,
-            (w - c.y / view.half_y) * half_h,
-            w,
-        )
-    });
+    // Far vertices scaled by a power of two (exact, no sign changes; see
+    // `edge3d::scaled`): the rows are ~|h|², the determinant's products ~|h|³.
+    let (h, scale) = scaled(p.map(|v| homogeneous_point(v, view)));
     // 2. Edge functions: rows of the adjugate, c_i = h_{i+1} × h_{i+2}, written as
     //    midpoint × difference (equal in real arithmetic, as in §3.4 "Numerics"):
     //    the plain cross product of two long, nearly parallel vectors cancels
@@ -40,23 +49,38 @@ pub fn setup_homogeneous(p: &[Vec3; 3], view: &View) -> Option<Triangle3D> {
     let rows = [row(h[1], h[2]), row(h[2], h[0]), row(h[0], h[1])];
     // 3. The determinant and 1/w's gradient from the triangle's own normal (Σ rows,
     //    computed without the cancellation of summing them): 1/w(x, y) = N·(x, y, 1) / D.
-    let normal = (h[1] - h[0]).cross(h[2] - h[0]);
+    //    Near zero the exact sign of det[h0, h1, h2] decides.
+    let (e1, e2) = (h[1] - h[0], h[2] - h[0]);
+    let normal = e1.cross(e2);
     let det = normal.dot(h[0]);
-    if det == 0.0 || !det.is_finite() {
-        return None;
-    }
-    let sign = if det > 0.0 { 1.0 } else { -1.0 };
+    let det_bound = 16.0 * EPS * abs_cross(e1, e2).dot(h[0].abs());
+    let positive = orientation(det, det_bound, || {
+        let v = h.map(|v| v.as_dvec3().to_array());
+        exact::dot(&exact::cross(v[1], v[2]), v[0]).signum()
+    })?;
+    let sign = if positive { 1.0 } else { -1.0 };
     let linear = |r: Vec3| [r.z * sign, r.x * sign, r.y * sign];
+    // w is homogeneous of degree 1 in h (orthographic: 0, W = 1 and the rows
+    // scale like the normal).
     let volume = if orthographic {
         linear(rows[0] * cam[0].z + rows[1] * cam[1].z + rows[2] * cam[2].z)
     } else {
-        [det.abs(), 0.0, 0.0]
+        [det.abs() * scale, 0.0, 0.0]
     };
+    // Each row's rounding is at most 5ε of |m| ⊗ |u|, evaluated at (x, y, 1).
+    let (x_max, y_max) = image_extent(view);
+    let coefficient_error = [0, 1, 2].map(|i| {
+        let (a, b) = (h[(i + 1) % 3], h[(i + 2) % 3]);
+        let t = abs_cross((a + b) * 0.5, b - a);
+        6.0 * EPS * (t.z + x_max * t.x + y_max * t.y)
+    });
     Triangle3D::from_linear(
         rows.map(linear),
         linear(normal),
         volume,
         cam.map(|c| c.z),
         view,
+        coefficient_error,
+        ExactEdges::new(ExactForm::Homogeneous, p, view, !positive),
     )
 }

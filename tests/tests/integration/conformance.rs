@@ -444,7 +444,9 @@ fn large_rotated_quads_partly_and_fully_clipped_cover_like_the_gpu() {
 fn direct3d_top_left_examples_match_the_gpu() {
     const SIZE: u32 = 16;
     let camera = pixel_camera(SIZE, SIZE);
-    let cases: [(&str, Vec<(f32, f32)>, Vec<[u32; 3]>, u32); 5] = [
+    // (name, corners in pixels, triangles, pixels covered or 0 for unchecked)
+    type Case = (&'static str, Vec<(f32, f32)>, Vec<[u32; 3]>, u32);
+    let cases: [Case; 5] = [
         // Top edge through centres (row 2 included), bottom edge through centres (row 6 excluded).
         (
             "axis-aligned rectangle",
