@@ -24,6 +24,7 @@ pub mod edge;
 pub mod framebuffer;
 #[cfg(feature = "gpu")]
 pub mod gpu;
+pub mod hardcases;
 pub mod maps;
 pub mod metrics;
 pub mod peer;

@@ -7,7 +7,7 @@ use clap::Args;
 use continuum::request::{parse_aa, parse_algorithm, parse_size, parse_viewport};
 use continuum::{AlgorithmId, Precision, PreparedScene, RenderRequest, maps, render};
 
-use crate::{CliError, scenes_dir};
+use crate::{CliError, scenes_dir, write_stdout};
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -103,14 +103,12 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     }
     let summary = out.summary(&prepared.scene.name, &request.camera.name);
     if args.json {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&summary).context("encoding JSON")?
-        );
+        let text = serde_json::to_string_pretty(&summary).context("encoding JSON")?;
+        write_stdout(&(text + "\n"))?;
     } else {
         let s = &out.stats;
-        println!(
-            "{} {} {}x{}: {:.2} ms (setup {:.2}, traversal {:.2}, coverage {:.2}, shading {:.2}); {} setups, {} edge evaluations, {} BVH nodes; coverage 0/1/many = {}/{}/{}; ids {}",
+        write_stdout(&format!(
+            "{} {} {}x{}: {:.2} ms (setup {:.2}, traversal {:.2}, coverage {:.2}, shading {:.2}); {} setups, {} edge evaluations, {} BVH nodes; coverage 0/1/many = {}/{}/{}; ids {}\n",
             summary.scene,
             summary.algorithm,
             width,
@@ -127,7 +125,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             s.coverage_histogram.one,
             s.coverage_histogram.many,
             out.hashes.triangle_id
-        );
+        ))?;
     }
     Ok(())
 }

@@ -22,7 +22,7 @@ use serde::Serialize;
 use serde_json::{Value, json};
 
 use crate::plot::{AaPoint, aa_cost_svg};
-use crate::{CliError, scenes_dir};
+use crate::{CliError, scenes_dir, write_stdout};
 
 #[derive(Args, Debug)]
 pub struct CompareArgs {
@@ -362,9 +362,9 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if args.json {
-        println!("{text}");
+        write_stdout(&(text + "\n"))?;
     } else {
-        print_table(&rows);
+        write_stdout(&table_text(&rows))?;
     }
     Ok(())
 }
@@ -659,8 +659,12 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
     Ok(())
 }
 
-fn print_table(rows: &[Row]) {
-    println!(
+/// The rows as a table for the terminal.
+fn table_text(rows: &[Row]) -> String {
+    use std::fmt::Write;
+    let mut out = String::new();
+    writeln!(
+        out,
         "{:<12} {:<18} {:<10} {:<5} {:>10} {:>8} {:>9} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
         "scene",
         "algorithm",
@@ -675,10 +679,12 @@ fn print_table(rows: &[Row]) {
         "edges dB",
         "FLIP",
         "agrees"
-    );
+    )
+    .ok();
     for r in rows {
         let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.2}"));
-        println!(
+        writeln!(
+            out,
             "{:<12} {:<18} {:<10} {:<5} {:>10.2} {:>8} {:>9} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
             r.scene,
             r.algorithm,
@@ -696,6 +702,8 @@ fn print_table(rows: &[Row]) {
                 Some(d) => format!("{d} px"),
                 None => r.agrees.to_string(),
             }
-        );
+        )
+        .ok();
     }
+    out
 }

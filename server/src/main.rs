@@ -8,6 +8,7 @@ use clap::{Parser, Subcommand};
 
 mod cli_render;
 mod compare;
+mod hardcases;
 mod plot;
 mod serve;
 
@@ -30,6 +31,8 @@ enum Command {
     Render(cli_render::RenderArgs),
     /// Run every algorithm and peer on scenes and write what each cost.
     Compare(compare::CompareArgs),
+    /// Run the numerical hard-case suite; exit status 1 on any violation.
+    Hardcases(hardcases::HardcasesArgs),
 }
 
 fn main() -> ExitCode {
@@ -38,6 +41,11 @@ fn main() -> ExitCode {
         Some(Command::Render(args)) => cli_render::run(&args),
         Some(Command::Compare(args)) => compare::run(&args),
         Some(Command::Serve(args)) => serve::run(&args),
+        Some(Command::Hardcases(args)) => match hardcases::run(&args) {
+            Ok(true) => Ok(()),
+            Ok(false) => return ExitCode::FAILURE,
+            Err(e) => Err(e),
+        },
         None => serve::run(&serve::ServeArgs::default()),
     };
     match result {
@@ -63,6 +71,18 @@ pub enum CliError {
 impl From<anyhow::Error> for CliError {
     fn from(e: anyhow::Error) -> Self {
         CliError::Failed(e)
+    }
+}
+
+/// Writes `text` to standard output. A reader that went away (`| head`) is
+/// not a failure: the rest is simply not written.
+pub fn write_stdout(text: &str) -> Result<(), CliError> {
+    use std::io::Write;
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(CliError::Failed(
+            anyhow::Error::new(e).context("writing to standard output"),
+        )),
+        _ => Ok(()),
     }
 }
 

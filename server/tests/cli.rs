@@ -445,3 +445,62 @@ fn embree_peers_need_the_feature() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("embree"));
 }
+
+fn hard_cases() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/hard_cases")
+}
+
+#[test]
+fn hardcases_prints_the_table_and_exits_by_the_invariants() {
+    let dir = hard_cases();
+    let dir = dir.to_str().expect("utf-8 path");
+    // One case through everything: the table, and success.
+    let out = continuum(&["hardcases", "--cases", dir, "--only", "fans"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        table.contains("fans") && table.contains("gpu-raster"),
+        "{table}"
+    );
+    // The JSON report: a table row per case and a checked render per variant.
+    let out = continuum(&[
+        "hardcases",
+        "--cases",
+        dir,
+        "--only",
+        "degenerate",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert_eq!(doc["passed"], true);
+    assert_eq!(doc["table"][0]["case"], "degenerate");
+    assert!(doc["checks"].as_array().is_some_and(|c| c.len() > 100));
+    // An unknown case is a usage error naming the flag.
+    let out = continuum(&["hardcases", "--cases", dir, "--only", "nosuch"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--only"));
+    // A case that breaks an invariant exits with status 1: huge-triangles
+    // without its documented limit (the GPU driver clips in f32).
+    let bad = out_dir("hardcases");
+    let text = std::fs::read_to_string(hard_cases().join("huge-triangles.toml")).expect("case");
+    let (head, rest) = text.split_once("[limits]").expect("the case has limits");
+    let rest = rest.split_once("\n\n").expect("limits table ends").1;
+    std::fs::write(bad.join("huge.toml"), format!("{head}{rest}")).expect("write case");
+    let out = continuum(&["hardcases", "--cases", bad.to_str().expect("utf-8")]);
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    std::fs::remove_dir_all(&bad).ok();
+}

@@ -6,7 +6,9 @@
 //! [[mesh]]                       # one or more
 //! file = "assets/stanford_bunny.glb"   # relative to this file (.gltf/.glb/.obj), or
 //! # generator = "teapots"              # a procedural generator, with
-//! # params = { count = 4, resolution = 8 }
+//! # params = { count = 4, resolution = 8 }, or
+//! # positions = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]   # the triangles themselves
+//! # triangles = [[0, 1, 2]]
 //! translate = [0, 0, 0]          # optional transform: scale, then rotate (degrees, XYZ), then translate
 //! rotate_deg = [0, 0, 0]
 //! scale = 1.0                    # or [x, y, z]
@@ -44,7 +46,9 @@ use glam::{EulerRot, Mat4, Quat, Vec3};
 use serde::Deserialize;
 
 use super::procedural::Generator;
-use super::{Light, LightKind, Material, Scene, SceneError, load_path};
+use super::{
+    Light, LightKind, Material, Mesh, PartLocation, Scene, SceneError, load_path, validate_part,
+};
 use crate::camera::{Camera, Viewport};
 
 /// The parsed TOML document.
@@ -70,6 +74,9 @@ pub struct MeshEntry {
     pub generator: Option<String>,
     #[serde(default)]
     pub params: toml::Table,
+    /// Inline geometry: vertex positions and triangles indexing them.
+    pub positions: Option<Vec<[f32; 3]>>,
+    pub triangles: Option<Vec<[u32; 3]>>,
     pub translate: Option<[f32; 3]>,
     pub rotate_deg: Option<[f32; 3]>,
     pub scale: Option<Scale>,
@@ -137,6 +144,14 @@ pub struct MaterialEntry {
     pub reflectivity: Option<f32>,
 }
 
+impl SceneFile {
+    /// The scene this document describes: `source` names it in messages,
+    /// `dir` resolves the files it references.
+    pub fn build(&self, source: &str, name: String, dir: &Path) -> Result<Scene, SceneError> {
+        build(self, source, name, dir)
+    }
+}
+
 /// Loads `path` (a scene file) with everything it references.
 pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
     let file = path.display().to_string();
@@ -175,8 +190,13 @@ fn build(doc: &SceneFile, file: &str, name: String, dir: &Path) -> Result<Scene,
     // 1. Meshes, each with its own materials, cameras and lights appended.
     let mut mesh_ranges = Vec::new();
     for (k, entry) in doc.mesh.iter().enumerate() {
-        let part = match (&entry.file, &entry.generator) {
-            (Some(f), None) => {
+        if entry.triangles.is_some() != entry.positions.is_some() {
+            return Err(err(format!(
+                "mesh {k}: 'positions' and 'triangles' go together"
+            )));
+        }
+        let part = match (&entry.file, &entry.generator, &entry.positions) {
+            (Some(f), None, None) => {
                 if !entry.params.is_empty() {
                     return Err(err(format!(
                         "mesh {k}: 'params' belongs with 'generator', not 'file'"
@@ -184,7 +204,7 @@ fn build(doc: &SceneFile, file: &str, name: String, dir: &Path) -> Result<Scene,
                 }
                 load_path(&dir.join(f))?
             }
-            (None, Some(g)) => {
+            (None, Some(g), None) => {
                 let generator = Generator::from_table(g, entry.params.clone())
                     .map_err(|m| err(format!("mesh {k} (generator '{g}'): {m}")))?;
                 let mesh = generator
@@ -198,9 +218,27 @@ fn build(doc: &SceneFile, file: &str, name: String, dir: &Path) -> Result<Scene,
                     ..Scene::default()
                 }
             }
+            (None, None, Some(positions)) => {
+                let triangles = entry.triangles.clone().unwrap_or_default();
+                let mesh = Mesh {
+                    positions: positions.iter().map(|&p| Vec3::from(p)).collect(),
+                    material_ids: vec![0; triangles.len()],
+                    triangles,
+                    ..Mesh::default()
+                };
+                let location = PartLocation::part(file, k.to_string(), None);
+                validate_part(&mesh.positions, &mesh.triangles, &location)?;
+                Scene {
+                    name: format!("mesh {k}"),
+                    source: file.to_string(),
+                    mesh,
+                    materials: vec![Material::default()],
+                    ..Scene::default()
+                }
+            }
             _ => {
                 return Err(err(format!(
-                    "mesh {k}: give exactly one of 'file' or 'generator'"
+                    "mesh {k}: give exactly one of 'file', 'generator' or 'positions' (with 'triangles')"
                 )));
             }
         };

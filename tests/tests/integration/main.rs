@@ -3,6 +3,7 @@
 mod aa;
 mod agreement;
 mod conformance;
+mod hard_cases;
 mod loaders;
 mod oracles;
 mod tie_rules;

@@ -1,4 +1,5 @@
-//! A tessellated plane at y = 0 with shared vertices.
+//! A tessellated plane with shared vertices: at y = 0 (`plane = "xz"`, the
+//! default) or at z = 0 (`plane = "xy"`).
 
 use glam::{Vec2, Vec3};
 use serde::Deserialize;
@@ -15,6 +16,9 @@ pub struct GridParams {
     /// Quads along x and z.
     #[serde(default = "divisions")]
     pub divisions: [u32; 2],
+    /// `xz` (the default) or `xy`: the plane the grid lies in.
+    #[serde(default)]
+    pub plane: Option<String>,
 }
 
 fn size() -> [f32; 2] {
@@ -35,13 +39,25 @@ impl GridParams {
             return Err(param_error("divisions", "both must be at least 1"));
         }
         check_count("divisions", 2 * u64::from(nx) * u64::from(nz))?;
+        let xy = match self.plane.as_deref() {
+            None | Some("xz") => false,
+            Some("xy") => true,
+            Some(other) => {
+                return Err(param_error("plane", format!("'{other}' is not xz or xy")));
+            }
+        };
         let mut mesh = Mesh::default();
         for j in 0..=nz {
             for i in 0..=nx {
                 let (u, v) = (i as f32 / nx as f32, j as f32 / nz as f32);
-                mesh.positions
-                    .push(Vec3::new((u - 0.5) * sx, 0.0, (v - 0.5) * sz));
-                mesh.normals.push(Vec3::Y);
+                let (a, b) = ((u - 0.5) * sx, (v - 0.5) * sz);
+                if xy {
+                    mesh.positions.push(Vec3::new(a, b, 0.0));
+                    mesh.normals.push(Vec3::Z);
+                } else {
+                    mesh.positions.push(Vec3::new(a, 0.0, b));
+                    mesh.normals.push(Vec3::Y);
+                }
                 mesh.uvs.push(Vec2::new(u, v));
             }
         }

@@ -6,8 +6,12 @@
 //! | `grid` | a plane `size = [x, z]` split into `divisions = [nx, nz]` quads, shared vertices |
 //! | `sphere` | an icosphere of `radius`, `subdivisions` levels, welded and closed |
 //! | `soup` | `count` random triangles from `seed`, sizes in `[min_size, max_size]`, inside a cube of half-size `extent` |
+//! | `fan` | `count` triangles around one shared centre vertex, ring at `radius`, first at `start_deg` (plane z = 0) |
+//! | `slivers` | `count` triangles of height `length` and aspect ratio `aspect` sharing long edges and one apex (plane z = 0) |
 
+mod fan;
 mod grid;
+mod slivers;
 mod soup;
 mod sphere;
 mod teapot;
@@ -15,7 +19,9 @@ mod weld;
 
 use serde::Deserialize;
 
+pub use fan::FanParams;
 pub use grid::GridParams;
+pub use slivers::SliverParams;
 pub use soup::SoupParams;
 pub use sphere::SphereParams;
 pub use teapot::{TEAPOT_PATCHES, TeapotParams};
@@ -32,6 +38,8 @@ pub enum Generator {
     Grid(GridParams),
     Sphere(SphereParams),
     Soup(SoupParams),
+    Fan(FanParams),
+    Slivers(SliverParams),
 }
 
 /// A generator parameter out of range, naming it.
@@ -61,7 +69,7 @@ pub(crate) fn check_count(field: &'static str, triangles: u64) -> Result<(), Par
 }
 
 impl Generator {
-    pub const NAMES: [&'static str; 4] = ["teapots", "grid", "sphere", "soup"];
+    pub const NAMES: [&'static str; 6] = ["teapots", "grid", "sphere", "soup", "fan", "slivers"];
 
     /// Builds a generator from its name and a table of parameters (unknown
     /// parameters are an error naming them).
@@ -76,6 +84,8 @@ impl Generator {
             "grid" => Generator::Grid(parse(params)?),
             "sphere" => Generator::Sphere(parse(params)?),
             "soup" => Generator::Soup(parse(params)?),
+            "fan" => Generator::Fan(parse(params)?),
+            "slivers" => Generator::Slivers(parse(params)?),
             other => {
                 return Err(format!(
                     "unknown generator '{other}'; generators are: {}",
@@ -91,6 +101,8 @@ impl Generator {
             Generator::Grid(_) => "grid",
             Generator::Sphere(_) => "sphere",
             Generator::Soup(_) => "soup",
+            Generator::Fan(_) => "fan",
+            Generator::Slivers(_) => "slivers",
         }
     }
 
@@ -101,6 +113,8 @@ impl Generator {
             Generator::Grid(p) => p.generate()?,
             Generator::Sphere(p) => p.generate()?,
             Generator::Soup(p) => p.generate()?,
+            Generator::Fan(p) => p.generate()?,
+            Generator::Slivers(p) => p.generate()?,
         };
         mesh.material_ids = vec![0; mesh.triangles.len()];
         Ok(mesh)
