@@ -1,6 +1,8 @@
 //! Shared helpers for continuum's integration tests: built-in scenes loaded and
 //! prepared once per test process, renders, and buffer comparisons.
 
+pub mod untrusted;
+
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};

@@ -4,7 +4,7 @@
 //! eye plane, degenerate input, closed meshes — each rendered by every
 //! algorithm at every precision it computes in, through every viewport that
 //! serves it, at the origin and far from it (offsets 10³ … 10⁷ with the camera
-//! alongside), and checked against an f64 reference ([`reference`]).
+//! alongside), and checked against an f64 reference ([`mod@reference`]).
 //!
 //! A case file:
 //! ```toml
@@ -359,67 +359,91 @@ pub fn run_case(case: &HardCase) -> Result<Vec<Check>, SceneError> {
     for &offset in case.offsets() {
         let scene = PreparedScene::new(case.scene(offset)?);
         for camera in &scene.scene.cameras {
-            let viewports = case.viewports(camera).unwrap_or_default();
-            for viewport in viewports {
+            for viewport in case.viewports(camera).unwrap_or_default() {
                 let camera = Camera {
                     viewport,
                     ..camera.clone()
                 };
-                let Ok(view) = View::new(&camera, width, height, scene.default_near) else {
-                    continue;
+                let view = ViewCase {
+                    case: &case.name,
+                    offset,
+                    limits: &case.file.limits,
                 };
-                let reference = Reference::compute(&scene, &view);
-                let mut renders: Vec<(Check, Option<RenderOutput>)> = Vec::new();
-                for (algorithm, precision) in variants(&viewport) {
-                    let mut check = Check {
-                        case: case.name.clone(),
-                        camera: camera.name.clone(),
-                        viewport: viewport.to_string(),
-                        offset,
-                        algorithm,
-                        precision,
-                        violations: Violations::default(),
-                        example: None,
-                        limit: case
-                            .file
-                            .limits
-                            .get(&variant_name(algorithm, precision))
-                            .or_else(|| case.file.limits.get(algorithm.as_str()))
-                            .cloned(),
-                    };
-                    let request = RenderRequest {
-                        algorithm,
-                        oracles: None,
-                        camera: camera.clone(),
-                        width,
-                        height,
-                        aa: AaMode::None,
-                        precision,
-                    };
-                    let out = match catch_unwind(AssertUnwindSafe(|| render(&scene, &request))) {
-                        Ok(Ok(out)) => {
-                            check_render(&scene, &reference, &out, &mut check);
-                            Some(out)
-                        }
-                        Ok(Err(e)) => {
-                            check.violations.error = 1;
-                            check.example = Some(format!("error: {e}"));
-                            None
-                        }
-                        Err(_) => {
-                            check.violations.error = 1;
-                            check.example = Some("panic".into());
-                            None
-                        }
-                    };
-                    renders.push((check, out));
-                }
-                check_agreement(&mut renders);
-                checks.extend(renders.into_iter().map(|(c, _)| c));
+                checks.extend(check_view(&scene, &camera, (width, height), &view));
             }
         }
     }
     Ok(checks)
+}
+
+/// What a checked view belongs to: its case, offset and documented limits.
+#[derive(Clone, Copy, Debug)]
+pub struct ViewCase<'a> {
+    pub case: &'a str,
+    pub offset: f64,
+    pub limits: &'a std::collections::BTreeMap<String, String>,
+}
+
+/// Renders `camera`'s view of `scene` at `width × height` with every
+/// (algorithm, precision) that serves its viewport and checks each against the
+/// f64 reference and the others of its family; nothing for a camera the view
+/// cannot be built from.
+pub fn check_view(
+    scene: &PreparedScene,
+    camera: &Camera,
+    (width, height): (u32, u32),
+    case: &ViewCase,
+) -> Vec<Check> {
+    let Ok(view) = View::new(camera, width, height, scene.default_near) else {
+        return Vec::new();
+    };
+    let reference = Reference::compute(scene, &view);
+    let mut renders: Vec<(Check, Option<RenderOutput>)> = Vec::new();
+    for (algorithm, precision) in variants(&camera.viewport) {
+        let mut check = Check {
+            case: case.case.to_string(),
+            camera: camera.name.clone(),
+            viewport: camera.viewport.to_string(),
+            offset: case.offset,
+            algorithm,
+            precision,
+            violations: Violations::default(),
+            example: None,
+            limit: case
+                .limits
+                .get(&variant_name(algorithm, precision))
+                .or_else(|| case.limits.get(algorithm.as_str()))
+                .cloned(),
+        };
+        let request = RenderRequest {
+            algorithm,
+            oracles: None,
+            camera: camera.clone(),
+            width,
+            height,
+            aa: AaMode::None,
+            precision,
+        };
+        let out = match catch_unwind(AssertUnwindSafe(|| render(scene, &request))) {
+            Ok(Ok(out)) => {
+                check_render(scene, &reference, &out, &mut check);
+                Some(out)
+            }
+            Ok(Err(e)) => {
+                check.violations.error = 1;
+                check.example = Some(format!("error: {e}"));
+                None
+            }
+            Err(_) => {
+                check.violations.error = 1;
+                check.example = Some("panic".into());
+                None
+            }
+        };
+        renders.push((check, out));
+    }
+    check_agreement(&mut renders);
+    renders.into_iter().map(|(c, _)| c).collect()
 }
 
 /// Notes one violation of `kind` at pixel `(x, y)`.

@@ -20,9 +20,9 @@ use glam::{Vec2, Vec3};
 
 pub use error::SceneError;
 pub use gltf_loader::{load_gltf, load_gltf_slice};
-pub use obj_loader::load_obj;
-pub use scene_file::{SceneFile, load_scene_file};
-pub use validate::{PartLocation, validate_part};
+pub use obj_loader::{load_obj, load_obj_slice};
+pub use scene_file::{SceneFile, load_scene_file, load_scene_file_str};
+pub use validate::{MAX_COORDINATE, PartLocation, validate_part};
 
 use crate::camera::Camera;
 

@@ -3,6 +3,19 @@
 
 use std::path::Path;
 
+/// How `tobj` reads every OBJ: triangles only, one index per vertex.
+const OPTIONS: tobj::LoadOptions = tobj::LoadOptions {
+    triangulate: true,
+    single_index: true,
+    ignore_points: true,
+    ignore_lines: true,
+};
+
+type Loaded = (
+    Vec<tobj::Model>,
+    Result<Vec<tobj::Material>, tobj::LoadError>,
+);
+
 use glam::{Vec2, Vec3};
 
 use super::validate::{PartLocation, validate_part};
@@ -10,28 +23,43 @@ use super::{Material, Mesh, Scene, SceneError};
 
 pub fn load_obj(path: &Path) -> Result<Scene, SceneError> {
     let file = path.display().to_string();
-    let options = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let (models, materials) = tobj::load_obj(path, &options).map_err(|e| match e {
+    let loaded = tobj::load_obj(path, &OPTIONS).map_err(|e| obj_error(&file, e))?;
+    let name = path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("scene")
+        .to_string();
+    build(loaded, &file, name)
+}
+
+/// An OBJ from bytes in memory (no material library: there is no folder to
+/// find one in); `name` names it in messages.
+pub fn load_obj_slice(bytes: &[u8], name: &str) -> Result<Scene, SceneError> {
+    let mut reader = std::io::BufReader::new(bytes);
+    let loaded = tobj::load_obj_buf(&mut reader, &OPTIONS, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| obj_error(name, e))?;
+    build(loaded, name, name.to_string())
+}
+
+fn obj_error(file: &str, e: tobj::LoadError) -> SceneError {
+    match e {
         tobj::LoadError::OpenFileFailed => SceneError::Io {
-            path: file.clone(),
+            path: file.to_string(),
             message: "cannot open".into(),
         },
         other => SceneError::Obj {
-            path: file.clone(),
+            path: file.to_string(),
             message: other.to_string(),
         },
-    })?;
+    }
+}
+
+fn build((models, materials): Loaded, file: &str, name: String) -> Result<Scene, SceneError> {
+    let file = file.to_string();
     let mut scene = Scene {
-        name: path
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .unwrap_or("scene")
-            .to_string(),
+        name,
         source: file.clone(),
         ..Scene::default()
     };

@@ -152,6 +152,16 @@ impl SceneFile {
     }
 }
 
+/// A scene file's text (`source` names it in messages; files it references
+/// are found in `dir`).
+pub fn load_scene_file_str(text: &str, source: &str, dir: &Path) -> Result<Scene, SceneError> {
+    let doc: SceneFile = toml::from_str(text).map_err(|e| SceneError::SceneFile {
+        path: source.to_string(),
+        message: e.to_string(),
+    })?;
+    build(&doc, source, source.to_string(), dir)
+}
+
 /// Loads `path` (a scene file) with everything it references.
 pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
     let file = path.display().to_string();

@@ -48,8 +48,13 @@ impl fmt::Display for PartLocation {
     }
 }
 
+/// The largest coordinate a position may have: beyond it the BVH's quantized
+/// child boxes (obvhs) break down and setup products approach f32's range.
+pub const MAX_COORDINATE: f32 = 1e18;
+
 /// Checks one part (a glTF primitive, an OBJ object, a generated mesh): every
-/// position finite, every index `< positions.len()`, at least one triangle.
+/// position finite and within ±[`MAX_COORDINATE`], every index
+/// `< positions.len()`, at least one triangle.
 pub fn validate_part(
     positions: &[Vec3],
     triangles: &[[u32; 3]],
@@ -60,6 +65,19 @@ pub fn validate_part(
             location: location.to_string(),
             problem: format!(
                 "vertex {i} has a non-finite position [{}, {}, {}]",
+                p.x, p.y, p.z
+            ),
+        });
+    }
+    if let Some((i, p)) = positions
+        .iter()
+        .enumerate()
+        .find(|(_, p)| p.abs().max_element() > MAX_COORDINATE)
+    {
+        return Err(SceneError::Invalid {
+            location: location.to_string(),
+            problem: format!(
+                "vertex {i} at [{}, {}, {}] is beyond ±{MAX_COORDINATE:e}, the largest coordinate continuum renders",
                 p.x, p.y, p.z
             ),
         });

@@ -143,3 +143,109 @@ fn a_bad_case_file_is_an_error_naming_the_key() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+mod random {
+    //! Property tests: random welded meshes (jittered grids, radially
+    //! jittered icospheres) seen by random cameras through every viewport hold
+    //! every invariant of the suite in every algorithm.
+
+    use continuum::hardcases::{self, ViewCase};
+    use continuum::scene::procedural::{GridParams, SphereParams};
+    use continuum::{Camera, Viewport};
+    use glam::{Quat, Vec3};
+    use proptest::prelude::*;
+
+    /// A welded mesh from `seed`: a grid with its inner vertices moved within
+    /// their cells, or an icosphere with every vertex moved along its radius
+    /// (both stay partitions: no triangle folds over).
+    fn mesh(seed: u64, sphere: bool) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let mut rng = fastrand::Rng::with_seed(seed);
+        let mut mesh = if sphere {
+            SphereParams {
+                radius: 1.0,
+                center: [0.0; 3],
+                subdivisions: rng.u32(0..=2),
+            }
+            .generate()
+            .expect("sphere")
+        } else {
+            let n = [rng.u32(1..=6), rng.u32(1..=6)];
+            GridParams {
+                size: [2.0, 2.0],
+                divisions: n,
+                plane: None,
+            }
+            .generate()
+            .expect("grid")
+        };
+        let cell = 2.0 / 6.0;
+        for p in &mut mesh.positions {
+            if sphere {
+                *p *= 0.9 + 0.2 * rng.f32();
+            } else if p.x.abs() < 0.999 && p.z.abs() < 0.999 {
+                p.x += (rng.f32() - 0.5) * 0.5 * cell;
+                p.z += (rng.f32() - 0.5) * 0.5 * cell;
+            }
+        }
+        let turn = Quat::from_euler(
+            glam::EulerRot::XYZ,
+            rng.f32() * 6.3,
+            rng.f32() * 6.3,
+            rng.f32() * 6.3,
+        );
+        let at = Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5);
+        let positions = mesh.positions.iter().map(|&p| turn * p + at).collect();
+        (positions, mesh.triangles)
+    }
+
+    fn camera(seed: u64, viewport: usize) -> Camera {
+        let mut rng = fastrand::Rng::with_seed(seed ^ 0x5eed);
+        let mut point = |s: f32| Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5) * s;
+        let (eye, target) = (point(6.0), point(1.0));
+        let viewport = match viewport {
+            0 => Viewport::Perspective {
+                fov_y_deg: 30.0 + 90.0 * rng.f32(),
+            },
+            1 => Viewport::Orthographic {
+                height: 1.0 + 3.0 * rng.f32(),
+            },
+            2 => Viewport::Parabolic,
+            _ => Viewport::LatLong,
+        };
+        Camera {
+            name: "random".into(),
+            eye,
+            target: if (target - eye).length() < 0.1 {
+                eye + Vec3::X
+            } else {
+                target
+            },
+            up: if rng.bool() { Vec3::Y } else { Vec3::Z },
+            viewport,
+            near: Some(0.01),
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 64, failure_persistence: None, ..ProptestConfig::default() })]
+
+        #[test]
+        fn random_welded_meshes_hold_every_invariant(
+            seed in any::<u64>(),
+            sphere in any::<bool>(),
+            viewport in 0usize..4,
+        ) {
+            let (positions, triangles) = mesh(seed, sphere);
+            let cam = camera(seed, viewport);
+            prop_assume!(cam.validate().is_ok());
+            let scene = continuum_tests::scene_from_triangles(positions, triangles, cam.clone());
+            let limits = Default::default();
+            let case = ViewCase { case: "random", offset: 0.0, limits: &limits };
+            let checks = hardcases::check_view(&scene, &cam, (32, 32), &case);
+            prop_assert!(!checks.is_empty());
+            for c in &checks {
+                prop_assert_eq!(c.violations.total(), 0, "{} {} {}: {:?} {:?}", c.algorithm, c.precision, c.viewport, c.violations, c.example);
+            }
+        }
+    }
+}
