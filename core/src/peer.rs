@@ -127,9 +127,12 @@ fn run_obvhs(scene: &PreparedScene, view: &View, repeat: u32) -> PeerRun {
                 .for_each(|(y, row)| {
                     let yc = pixel_center(y as u32);
                     for (x, out) in row.iter_mut().enumerate() {
-                        let dir = view.direction(pixel_center(x as u32), yc);
+                        // Every viewport's ray (none outside the parabolic disc).
+                        let Some((origin, dir)) = view.ray(pixel_center(x as u32), yc) else {
+                            continue;
+                        };
                         let ray =
-                            Ray::new(Vec3A::from(view.eye), Vec3A::from(dir), 0.0, f32::INFINITY);
+                            Ray::new(Vec3A::from(origin), Vec3A::from(dir), 0.0, f32::INFINITY);
                         let mut hit = RayHit::none();
                         if bvh.ray_traverse(ray, &mut hit, |ray, id| {
                             triangles[bvh.primitive_indices[id] as usize].intersect(ray)
@@ -189,10 +192,14 @@ mod embree_peer {
         let committed = embree_scene.commit();
         let build_ms = start.elapsed().as_secs_f64() * 1e3;
 
-        let eye = Vector3::new(view.eye.x, view.eye.y, view.eye.z);
+        // Every viewport's ray; where it casts none (outside the parabolic
+        // disc), an empty segment that hits nothing.
         let ray_at = |x: usize, y: usize| {
-            let d = view.direction(pixel_center(x as u32), pixel_center(y as u32));
-            RayHit::new(Ray::new(eye, Vector3::new(d.x, d.y, d.z)))
+            let v = |p: glam::Vec3| Vector3::new(p.x, p.y, p.z);
+            match view.ray(pixel_center(x as u32), pixel_center(y as u32)) {
+                Some((o, d)) => RayHit::new(Ray::new(v(o), v(d))),
+                None => RayHit::new(Ray::segment(v(view.eye), v(view.forward), 0.0, 0.0)),
+            }
         };
         let id_of = |hit: &RayHit| {
             if hit.hit.geomID == u32::MAX {

@@ -504,3 +504,178 @@ fn hardcases_prints_the_table_and_exits_by_the_invariants() {
     );
     std::fs::remove_dir_all(&bad).ok();
 }
+
+/// A row of results.json without what timing decides (times, their ratios,
+/// rays per second, stage times), as text, for comparing runs.
+fn untimed(row: &serde_json::Value) -> String {
+    let mut row = row.clone();
+    let map = row.as_object_mut().expect("row is an object");
+    for key in [
+        "median_ms",
+        "min_ms",
+        "max_ms",
+        "rays_per_second",
+        "ratio_to_2dr_brute",
+        "ratio_to_aa_none",
+        "ratio_to_f32",
+    ] {
+        map.remove(key);
+    }
+    if let Some(stats) = map.get_mut("stats").and_then(|s| s.as_object_mut()) {
+        stats.remove("time_ms");
+        stats.remove("bvh_build_ms");
+    }
+    row.to_string()
+}
+
+fn rows_of(dir: &std::path::Path) -> Vec<String> {
+    let mut rows: Vec<String> = results_json(dir)["rows"]
+        .as_array()
+        .expect("rows")
+        .iter()
+        .map(untimed)
+        .collect();
+    rows.sort();
+    rows
+}
+
+#[test]
+fn sharded_sweeps_merge_into_the_unsharded_results_and_report() {
+    let base = out_dir("sweep");
+    let sweep = base.join("sweep.toml");
+    std::fs::write(
+        &sweep,
+        "scenes = [\"box\", \"sphere\"]\nalgorithms = [\"2dr-brute\", \"2dr-bin\", \"3dr-brute\", \"raycast\", \"peer-obvhs\"]\n\
+         viewports = [\"camera\", \"orthographic\"]\naa = [\"none\", \"msaa:4\"]\nprecision = [\"f32\", \"f64\"]\n\
+         size = \"48x32\"\nrepeat = 1\nthreads = 2\n",
+    )
+    .expect("sweep file");
+    let run = |args: &[&str]| {
+        let out = continuum(args);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    let s = sweep.to_str().expect("utf-8");
+    let whole = base.join("whole");
+    run(&[
+        "compare",
+        "--sweep",
+        s,
+        "--out",
+        whole.to_str().expect("utf-8"),
+    ]);
+    let mut parts = Vec::new();
+    for i in 0..3 {
+        let dir = base.join(format!("shard-{i}"));
+        let shard = format!("{i}/3");
+        run(&[
+            "compare",
+            "--sweep",
+            s,
+            "--shard",
+            &shard,
+            "--out",
+            dir.to_str().expect("utf-8"),
+        ]);
+        parts.push(dir);
+    }
+    // Shards are disjoint and none is empty.
+    let counts: Vec<usize> = parts.iter().map(|d| rows_of(d).len()).collect();
+    assert!(counts.iter().all(|&n| n > 0), "{counts:?}");
+    let merged = base.join("merged");
+    let mut args = vec!["compare", "merge", "--out", merged.to_str().expect("utf-8")];
+    args.extend(parts.iter().map(|p| p.to_str().expect("utf-8")));
+    run(&args);
+    assert_eq!(counts.iter().sum::<usize>(), rows_of(&whole).len());
+    assert_eq!(rows_of(&merged), rows_of(&whole));
+    // The report names every scene and algorithm, and embeds its maps.
+    let html = std::fs::read_to_string(merged.join("report.html")).expect("report.html");
+    for name in [
+        "box",
+        "sphere",
+        "2dr-brute",
+        "2dr-bin",
+        "3dr-brute",
+        "raycast",
+        "peer-obvhs",
+    ] {
+        assert!(html.contains(name), "report lacks {name}");
+    }
+    assert!(html.contains("data:image/png;base64,") && html.contains("<svg"));
+    // Self-contained: nothing to fetch but the SVG namespace name.
+    assert!(!html.contains("src=\"http") && !html.contains("href=\"http"));
+    // A merge missing a shard says which.
+    let out = continuum(&[
+        "compare",
+        "merge",
+        "--out",
+        base.join("partial").to_str().expect("utf-8"),
+        parts[0].to_str().expect("utf-8"),
+        parts[2].to_str().expect("utf-8"),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("[1]"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    std::fs::remove_dir_all(&base).ok();
+}
+
+#[test]
+fn a_bad_sweep_file_is_an_error_naming_the_key() {
+    let base = out_dir("bad-sweep");
+    for (text, key) in [
+        (
+            "scenes = [\"box\"]\nalgoritms = [\"raycast\"]\n",
+            "algoritms",
+        ),
+        ("scenes = [\"box\"]\naa = [\"msaa:3\"]\n", "aa"),
+        ("scenes = [\"box\"]\nprecision = [\"f16\"]\n", "precision"),
+        (
+            "scenes = [\"box\"]\nviewports = [\"fisheye\"]\n",
+            "viewports",
+        ),
+        ("scenes = [\"box\"]\nsize = \"0x4\"\n", "size"),
+        ("scenes = [\"box\"]\nrepeat = 0\n", "repeat"),
+    ] {
+        let path = base.join("sweep.toml");
+        std::fs::write(&path, text).expect("sweep file");
+        let out = continuum(&[
+            "compare",
+            "--sweep",
+            path.to_str().expect("utf-8"),
+            "--out",
+            base.to_str().expect("utf-8"),
+        ]);
+        assert_eq!(out.status.code(), Some(2), "{text}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(key) && err.contains("--sweep"),
+            "{text}: {err}"
+        );
+    }
+    let out = continuum(&[
+        "compare",
+        "--sweep",
+        "/nonexistent/sweep.toml",
+        "--out",
+        "/tmp/never",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = continuum(&[
+        "compare",
+        "--scenes",
+        "box",
+        "--shard",
+        "3/3",
+        "--out",
+        "/tmp/never",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--shard"));
+    std::fs::remove_dir_all(&base).ok();
+}

@@ -1,0 +1,328 @@
+//! Measuring the cells of a sweep: every algorithm and peer of a cell timed
+//! over repeats, with the relations only the cell's own buffers can decide —
+//! family agreement, pixels a peer differs by, error against the `ssaa:256`
+//! reference — and an edge-evaluation thumbnail per render for the report.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use anyhow::Context;
+use continuum::metrics::{self, ImageError};
+use continuum::peer::run_peer;
+use continuum::{
+    AaMode, AlgorithmId, Camera, Framebuffer, Precision, PreparedScene, RenderRequest, View, maps,
+    render,
+};
+use serde_json::{Value, json};
+
+use super::Row;
+use super::sweep::{Cell, Entry, Sweep};
+use crate::CliError;
+
+/// Largest side of the edge-evaluation thumbnails the report shows.
+const THUMBNAIL: u32 = 320;
+
+/// A scene loaded and prepared once for all its cells, and its AA references
+/// per viewport.
+pub struct LoadedScene {
+    pub prepared: PreparedScene,
+    pub camera: Camera,
+    references: HashMap<String, Reference>,
+}
+
+impl LoadedScene {
+    pub fn load(
+        arg: &str,
+        sweep: &Sweep,
+        scenes_dir: &Path,
+        pool: &rayon::ThreadPool,
+    ) -> Result<LoadedScene, CliError> {
+        let scene = continuum::scene::load_named_or_path(arg, scenes_dir)
+            .map_err(|e| CliError::Usage(format!("scenes: {e}")))?;
+        let camera = match &sweep.camera {
+            Some(name) => scene
+                .camera(name)
+                .map_err(|e| CliError::Usage(format!("camera: {e}")))?,
+            None => scene.first_camera(),
+        };
+        Ok(LoadedScene {
+            prepared: pool.install(|| PreparedScene::new(scene)),
+            camera,
+            references: HashMap::new(),
+        })
+    }
+}
+
+/// Measures every entry of `cell` that serves it; the rows carry the in-cell
+/// relations. Thumbnails go to `out/maps/`.
+pub fn measure_cell(
+    cell: &Cell,
+    scene: &mut LoadedScene,
+    sweep: &Sweep,
+    pool: &rayon::ThreadPool,
+    out: &Path,
+    progress: &indicatif::ProgressBar,
+) -> Result<Vec<Row>, CliError> {
+    let mut camera = scene.camera.clone();
+    camera.viewport = cell.viewport.apply(&camera)?;
+    let (width, height) = sweep.size;
+    let threads = pool.current_num_threads();
+    let name = scene.prepared.scene.name.clone();
+    // With anti-aliasing in the sweep every mode, `none` too, is measured
+    // against the scene's reference.
+    let reference = if !sweep.with_reference {
+        None
+    } else {
+        let key = camera.viewport.to_string();
+        if !scene.references.contains_key(&key) {
+            progress.set_message(format!(
+                "{name} {key}: {} reference",
+                continuum::aa::REFERENCE
+            ));
+            let r = pool.install(|| Reference::render(&scene.prepared, &camera, sweep.size))?;
+            scene.references.insert(key.clone(), r);
+        }
+        scene.references.get(&key)
+    };
+    let mut measured: Vec<Measured> = Vec::new();
+    for &entry in &sweep.entries {
+        let serves = match entry {
+            Entry::Algorithm(a) => {
+                camera.viewport.serves(a)
+                    && cell.precision.serves(a.family())
+                    && (a != AlgorithmId::GpuRaster || cell.aa == AaMode::None)
+            }
+            // Peers cast one ray per pixel in their own precision.
+            Entry::Peer(_) => cell.aa == AaMode::None && cell.precision == Precision::F32,
+        };
+        if !serves {
+            continue;
+        }
+        progress.set_message(format!(
+            "{name} {} {} {}: {}",
+            camera.viewport,
+            cell.aa,
+            cell.precision,
+            entry.name()
+        ));
+        let mut m = match entry {
+            Entry::Algorithm(a) => {
+                measure_algorithm(pool, scene, &camera, (a, cell), sweep, threads)?
+            }
+            Entry::Peer(p) => {
+                let view = View::new(&camera, width, height, scene.prepared.default_near)
+                    .map_err(|e| CliError::Usage(format!("camera: {e}")))?;
+                let run = pool
+                    .install(|| run_peer(p, &scene.prepared, &view, sweep.repeat))
+                    .map_err(|e| CliError::Usage(format!("algorithms: {e}")))?;
+                let mut row = Row::timed(&name, p.as_str(), sweep.size, threads, run.times_ms)
+                    .with(
+                        &camera.viewport.to_string(),
+                        "none",
+                        json!({ "bvh_build_ms": run.build_ms }),
+                    );
+                row.coverage_samples = u64::from(width) * u64::from(height);
+                Measured {
+                    row,
+                    keys: run.triangle_id.iter().map(|&t| u64::from(t)).collect(),
+                    fb: None,
+                }
+            }
+        };
+        m.row.cell = cell.index;
+        m.row.camera = camera.name.clone();
+        if let (Some(r), Some(fb)) = (reference, &m.fb) {
+            m.row.error(r.error_of(fb));
+        }
+        if let Some(fb) = &m.fb {
+            m.row.map = Some(write_thumbnail(out, &m.row, fb)?);
+        }
+        measured.push(m);
+        progress.inc(1);
+    }
+    relate_in_cell(&mut measured);
+    Ok(measured.into_iter().map(|m| m.row).collect())
+}
+
+/// One measured row, the key that decides agreement (per pixel: the triangle
+/// id, or the digest of every sample's id under anti-aliasing) and, for
+/// continuum's own algorithms, the framebuffer.
+struct Measured {
+    row: Row,
+    keys: Vec<u64>,
+    fb: Option<Framebuffer>,
+}
+
+fn measure_algorithm(
+    pool: &rayon::ThreadPool,
+    scene: &LoadedScene,
+    camera: &Camera,
+    (algorithm, cell): (AlgorithmId, &Cell),
+    sweep: &Sweep,
+    threads: usize,
+) -> Result<Measured, CliError> {
+    let request = RenderRequest {
+        algorithm,
+        oracles: None,
+        camera: camera.clone(),
+        width: sweep.size.0,
+        height: sweep.size.1,
+        aa: cell.aa,
+        precision: cell.precision,
+    };
+    let run = || {
+        pool.install(|| render(&scene.prepared, &request))
+            .map_err(|e| CliError::Usage(format!("{e}")))
+    };
+    // One warm-up render (the GPU uploads the scene then), then the timed ones.
+    let mut out = run()?;
+    let mut times = Vec::new();
+    for _ in 0..sweep.repeat {
+        out = run()?;
+        times.push(out.stats.time_ms.total);
+    }
+    let mut row = Row::timed(
+        &scene.prepared.scene.name,
+        algorithm.as_str(),
+        sweep.size,
+        threads,
+        times,
+    )
+    .with(
+        &out.viewport,
+        &out.aa,
+        serde_json::to_value(&out.stats).unwrap_or(Value::Null),
+    );
+    row.hashes = serde_json::to_value(&out.hashes).unwrap_or(Value::Null);
+    row.precision = cell.precision;
+    row.shading_samples = out.stats.shading_samples;
+    row.coverage_samples = out.stats.coverage_samples;
+    let fb = out.framebuffer;
+    let keys = if fb.sample_digest.is_empty() {
+        fb.triangle_id.iter().map(|&t| u64::from(t)).collect()
+    } else {
+        fb.sample_digest.clone()
+    };
+    Ok(Measured {
+        row,
+        keys,
+        fb: Some(fb),
+    })
+}
+
+/// Family agreement (the first member of each family in the cell is its
+/// reference) and, for the peers and the GPU, the pixels differing from
+/// `3dr-brute`.
+fn relate_in_cell(rows: &mut [Measured]) {
+    let three_d = rows
+        .iter()
+        .position(|m| m.row.algorithm == AlgorithmId::ThreeDBrute.as_str());
+    let mut family_reference: HashMap<String, usize> = HashMap::new();
+    for i in 0..rows.len() {
+        let cpu = AlgorithmId::CPU
+            .into_iter()
+            .find(|a| a.as_str() == rows[i].row.algorithm);
+        match cpu {
+            Some(a) => {
+                let family = format!("{:?}", a.family());
+                let reference = *family_reference.entry(family).or_insert(i);
+                rows[i].row.agrees = rows[i].keys == rows[reference].keys;
+            }
+            None => {
+                if let Some(j) = three_d {
+                    let differing = rows[j]
+                        .keys
+                        .iter()
+                        .zip(&rows[i].keys)
+                        .filter(|(a, b)| a != b)
+                        .count() as u64;
+                    rows[i].row.pixels_differing_from_3dr_brute = Some(differing);
+                    rows[i].row.agrees = differing == 0;
+                }
+            }
+        }
+    }
+}
+
+/// The render's edge-evaluation map, scaled to at most [`THUMBNAIL`] pixels a
+/// side, as `maps/SCENE/CELL-ALGORITHM.png` under `out`; returns that path.
+fn write_thumbnail(out: &Path, row: &Row, fb: &Framebuffer) -> Result<String, CliError> {
+    let image = maps::edge_eval_image(fb);
+    let (w, h) = (image.width(), image.height());
+    let scale = (f64::from(THUMBNAIL) / f64::from(w.max(h))).min(1.0);
+    let thumb = image::imageops::thumbnail(
+        &image,
+        ((f64::from(w) * scale) as u32).max(1),
+        ((f64::from(h) * scale) as u32).max(1),
+    );
+    let rel = format!(
+        "maps/{}/{}-{}.png",
+        sanitize(&row.scene),
+        row.cell,
+        sanitize(&row.algorithm)
+    );
+    let path = out.join(&rel);
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    std::fs::write(&path, maps::png_bytes(&thumb))
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(rel)
+}
+
+/// A name safe as a file name.
+fn sanitize(s: &str) -> String {
+    s.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// The reference of a scene: `ssaa:256` by `3dr-bin`, and the pixels where the
+/// image without anti-aliasing differs from it (where anti-aliasing matters).
+struct Reference {
+    color: Vec<[u8; 4]>,
+    edges: Vec<bool>,
+    width: u32,
+    height: u32,
+}
+
+impl Reference {
+    fn render(
+        prepared: &PreparedScene,
+        camera: &Camera,
+        (width, height): (u32, u32),
+    ) -> Result<Reference, CliError> {
+        let request = |aa| RenderRequest {
+            algorithm: AlgorithmId::ThreeDBin,
+            oracles: None,
+            camera: camera.clone(),
+            width,
+            height,
+            aa,
+            precision: Precision::F32,
+        };
+        let run = |aa| {
+            render(prepared, &request(aa))
+                .map(|o| o.framebuffer.color)
+                .map_err(|e| CliError::Usage(format!("{e}")))
+        };
+        let color = run(continuum::aa::REFERENCE)?;
+        let edges = metrics::differing_pixels(&run(AaMode::None)?, &color);
+        Ok(Reference {
+            color,
+            edges,
+            width,
+            height,
+        })
+    }
+
+    fn error_of(&self, fb: &Framebuffer) -> ImageError {
+        metrics::compare(&self.color, &fb.color, &self.edges, self.width, self.height)
+    }
+}

@@ -1,0 +1,595 @@
+//! `continuum compare`: the benchmark. Every algorithm and peer on every scene,
+//! viewport, anti-aliasing mode and precision of a sweep, in one process,
+//! timed as medians over repeats and reported as ratios to `2dr-brute` (the
+//! paper's Fig. 9 form), with the counters that explain them. Writes
+//! `results.json`, `results.csv`, `report.html` (and `aa_cost.svg` with
+//! anti-aliasing) into `--out`. A sweep can run in disjoint shards
+//! (`--shard I/N`) and be merged (`continuum compare merge`).
+
+mod measure;
+mod report;
+pub mod sweep;
+
+use std::collections::HashMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use clap::{Args, Subcommand};
+use continuum::Precision;
+use continuum::metrics::ImageError;
+use serde::{Deserialize, Serialize};
+use serde_json::{Value, json};
+
+use crate::plot::{AaPoint, aa_cost_svg};
+use crate::{CliError, scenes_dir, write_stdout};
+use measure::{LoadedScene, measure_cell};
+use sweep::{Shard, Sweep, SweepFile, read_sweep_file};
+
+#[derive(Args, Debug)]
+#[command(args_conflicts_with_subcommands = true)]
+pub struct CompareArgs {
+    #[command(subcommand)]
+    command: Option<CompareCommand>,
+    /// A sweep file describing the matrix (scenes, algorithms, viewports, aa,
+    /// precision, size, repeat, threads, camera); instead of those flags.
+    #[arg(long, conflicts_with_all = ["scenes", "algorithms", "camera", "viewports", "aa", "precision", "size", "repeat", "threads"])]
+    sweep: Option<PathBuf>,
+    /// Run only part I of N (0-based: 0/4 … 3/4) of the sweep's cells.
+    #[arg(long, value_parser = Shard::parse)]
+    shard: Option<Shard>,
+    /// Scenes: built-in names or paths, comma-separated [default: every built-in scene].
+    #[arg(long, value_delimiter = ',')]
+    scenes: Vec<String>,
+    /// Algorithm ids and peers (peer-obvhs; peer-embree and peer-embree-stream with
+    /// the `embree` feature), comma-separated [default: all that are built in].
+    #[arg(long, value_delimiter = ',')]
+    algorithms: Vec<String>,
+    /// Camera name; default: each scene's first camera.
+    #[arg(long)]
+    camera: Option<String>,
+    /// Viewports, comma-separated: `camera` (the camera's own), perspective[:FOV],
+    /// orthographic[:HEIGHT], parabolic, latlong [default: camera].
+    #[arg(long, value_delimiter = ',')]
+    viewports: Vec<String>,
+    /// Image size, WIDTHxHEIGHT [default: 1280x720].
+    #[arg(long)]
+    size: Option<String>,
+    /// Timed runs per scene and algorithm, after one warm-up run [default: 3].
+    #[arg(long)]
+    repeat: Option<u32>,
+    /// Worker threads [default: all cores].
+    #[arg(long)]
+    threads: Option<u32>,
+    /// Anti-aliasing modes, comma-separated (none, ssaa:N, msaa:N, csaa:CxS);
+    /// each is measured against a ssaa:256 reference and plotted in aa_cost.svg
+    /// [default: none, without a reference].
+    #[arg(long, value_delimiter = ',')]
+    aa: Vec<String>,
+    /// Precisions, comma-separated (f32, f64 for the 3D family, fixed for the 2D
+    /// family); each algorithm runs at every one it computes in, and rows
+    /// report their time against f32 [default: f32].
+    #[arg(long, value_delimiter = ',')]
+    precision: Vec<String>,
+    /// Folder for results.json, results.csv and report.html.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Also print results.json on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Folder of built-in scenes.
+    #[arg(long = "scenes-dir")]
+    scenes_dir: Option<PathBuf>,
+}
+
+#[derive(Subcommand, Debug)]
+enum CompareCommand {
+    /// Merge the outputs of shard runs into one results.json and report.html.
+    Merge(MergeArgs),
+}
+
+#[derive(Args, Debug)]
+struct MergeArgs {
+    /// Folders written by `continuum compare --shard I/N --out DIR`.
+    #[arg(required = true)]
+    shards: Vec<PathBuf>,
+    /// Folder for the merged results.json, results.csv and report.html.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// One measured row of results.json.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Row {
+    pub scene: String,
+    pub algorithm: String,
+    #[serde(default)]
+    pub camera: String,
+    pub viewport: String,
+    pub aa: String,
+    pub precision: Precision,
+    pub width: u32,
+    pub height: u32,
+    pub threads: usize,
+    pub median_ms: f64,
+    pub min_ms: f64,
+    pub max_ms: f64,
+    pub ratio_to_2dr_brute: Option<f64>,
+    pub predicted_ratio: Option<f64>,
+    pub rays_per_second: f64,
+    pub stats: Value,
+    pub hashes: Value,
+    /// Does the triangle-id buffer equal its family's reference (for peers and
+    /// the GPU: 3dr-brute's)?
+    pub agrees: bool,
+    /// Pixels whose triangle id differs from 3dr-brute's (peers and the GPU).
+    pub pixels_differing_from_3dr_brute: Option<u64>,
+    /// Time against the same algorithm without anti-aliasing (when measured).
+    pub ratio_to_aa_none: Option<f64>,
+    /// Time against the same algorithm and mode at f32 (when measured).
+    pub ratio_to_f32: Option<f64>,
+    /// Shading evaluations and coverage samples of the render.
+    pub shading_samples: u64,
+    pub coverage_samples: u64,
+    /// Error against the ssaa:256 reference (with anti-aliasing modes).
+    pub psnr: Option<f64>,
+    pub psnr_edges: Option<f64>,
+    pub flip_mean: Option<f64>,
+    /// The sweep cell (scene, viewport, mode, precision) the row belongs to.
+    #[serde(default)]
+    pub cell: usize,
+    /// The edge-evaluation thumbnail, relative to the output folder.
+    #[serde(default)]
+    pub map: Option<String>,
+}
+
+impl Row {
+    /// A row from timed repetitions (median, min, max, rays per second); the
+    /// relations to other rows are filled in later.
+    fn timed(
+        scene: &str,
+        algorithm: &str,
+        (width, height): (u32, u32),
+        threads: usize,
+        times: Vec<f64>,
+    ) -> Row {
+        let (median_ms, min_ms, max_ms) = median(times);
+        Row {
+            scene: scene.to_string(),
+            algorithm: algorithm.to_string(),
+            camera: String::new(),
+            viewport: String::new(),
+            aa: String::new(),
+            precision: Precision::F32,
+            width,
+            height,
+            threads,
+            median_ms,
+            min_ms,
+            max_ms,
+            ratio_to_2dr_brute: None,
+            predicted_ratio: None,
+            rays_per_second: f64::from(width) * f64::from(height) / (median_ms / 1e3),
+            stats: Value::Null,
+            hashes: Value::Null,
+            agrees: false,
+            pixels_differing_from_3dr_brute: None,
+            ratio_to_aa_none: None,
+            ratio_to_f32: None,
+            shading_samples: 0,
+            coverage_samples: 0,
+            psnr: None,
+            psnr_edges: None,
+            flip_mean: None,
+            cell: 0,
+            map: None,
+        }
+    }
+
+    fn with(mut self, viewport: &str, aa: &str, stats: Value) -> Row {
+        self.viewport = viewport.to_string();
+        self.aa = aa.to_string();
+        self.stats = stats;
+        self
+    }
+
+    fn error(&mut self, e: ImageError) {
+        self.psnr = e.psnr;
+        self.psnr_edges = e.psnr_edges;
+        self.flip_mean = Some(e.flip_mean);
+    }
+}
+
+fn median(mut v: Vec<f64>) -> (f64, f64, f64) {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    let m = if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    };
+    (m, v[0], v[n - 1])
+}
+
+pub fn run(args: &CompareArgs) -> Result<(), CliError> {
+    if let Some(CompareCommand::Merge(m)) = &args.command {
+        return merge(m);
+    }
+    let out = args
+        .out
+        .clone()
+        .ok_or_else(|| CliError::Usage("--out: the folder for the results is required".into()))?;
+    let dir = scenes_dir(args.scenes_dir.as_ref());
+    let file = match &args.sweep {
+        Some(path) => read_sweep_file(path)?,
+        None => sweep_from_flags(args),
+    };
+    let sweep =
+        Sweep::new(file, || continuum::scene::builtin_names(&dir)).map_err(|e| match e {
+            CliError::Usage(m) if args.sweep.is_none() => CliError::Usage(format!("--{m}")),
+            CliError::Usage(m) => CliError::Usage(format!("--sweep: {m}")),
+            other => other,
+        })?;
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let threads = sweep
+        .threads
+        .map_or_else(rayon::current_num_threads, |t| t as usize);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("building the thread pool")?;
+
+    // 1. The cells this run measures.
+    let cells: Vec<sweep::Cell> = sweep
+        .cells()
+        .into_iter()
+        .filter(|c| args.shard.is_none_or(|s| s.takes(c)))
+        .collect();
+    let steps = (cells.len() * sweep.entries.len()) as u64;
+    let progress = indicatif::ProgressBar::new(steps).with_style(
+        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} [{elapsed}]")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    // 2. Scene by scene (each loaded and prepared once), cell by cell.
+    let mut rows = Vec::new();
+    let mut loaded: Option<(String, LoadedScene)> = None;
+    for cell in &cells {
+        if loaded.as_ref().is_none_or(|(name, _)| *name != cell.scene) {
+            progress.set_message(format!("{}: preparing", cell.scene));
+            loaded = Some((
+                cell.scene.clone(),
+                LoadedScene::load(&cell.scene, &sweep, &dir, &pool)?,
+            ));
+        }
+        let Some((_, scene)) = &mut loaded else {
+            continue;
+        };
+        rows.extend(measure_cell(cell, scene, &sweep, &pool, &out, &progress)?);
+    }
+    progress.finish_and_clear();
+    relate(&mut rows);
+
+    // 3. The outputs.
+    let meta = json!({
+        "machine": machine(threads),
+        "command": std::env::args().collect::<Vec<_>>().join(" "),
+        "sweep": sweep.file,
+        "shard": args.shard,
+    });
+    let text = write_outputs(&out, meta, &rows, &out)?;
+    if args.json {
+        write_stdout(&(text + "\n"))?;
+    } else {
+        write_stdout(&table_text(&rows))?;
+    }
+    Ok(())
+}
+
+/// The sweep the matrix flags describe.
+fn sweep_from_flags(args: &CompareArgs) -> SweepFile {
+    let list = |v: &Vec<String>| (!v.is_empty()).then(|| v.clone());
+    SweepFile {
+        scenes: args.scenes.clone(),
+        algorithms: list(&args.algorithms),
+        viewports: list(&args.viewports),
+        aa: list(&args.aa),
+        precision: list(&args.precision),
+        size: args.size.clone(),
+        repeat: args.repeat,
+        threads: args.threads,
+        camera: args.camera.clone(),
+    }
+}
+
+/// The relations between rows of different cells, from their medians alone
+/// (so a merge of shards computes them as an unsharded run does): the ratio
+/// to `2dr-brute` of the same scene, viewport and mode at f32 (time and
+/// predicted instructions), to the same algorithm without anti-aliasing, and
+/// to the same algorithm at f32.
+pub fn relate(rows: &mut [Row]) {
+    let key = |r: &Row| (r.scene.clone(), r.viewport.clone(), r.camera.clone());
+    let brute: HashMap<_, (f64, Option<f64>)> = rows
+        .iter()
+        .filter(|r| r.algorithm == "2dr-brute" && r.precision == Precision::F32)
+        .map(|r| {
+            let k = (key(r), r.aa.clone());
+            (k, (r.median_ms, r.stats["predicted_instructions"].as_f64()))
+        })
+        .collect();
+    let none: HashMap<_, f64> = rows
+        .iter()
+        .filter(|r| r.aa == "none")
+        .map(|r| ((key(r), r.algorithm.clone(), r.precision), r.median_ms))
+        .collect();
+    let single: HashMap<_, f64> = rows
+        .iter()
+        .filter(|r| r.precision == Precision::F32)
+        .map(|r| ((key(r), r.algorithm.clone(), r.aa.clone()), r.median_ms))
+        .collect();
+    for r in rows.iter_mut() {
+        let base = brute.get(&(key(r), r.aa.clone()));
+        r.ratio_to_2dr_brute = base.map(|(ms, _)| r.median_ms / ms);
+        r.predicted_ratio = base.and_then(|(_, instructions)| {
+            let ours = r.stats["predicted_instructions"].as_f64()?;
+            let base = (*instructions)?;
+            (ours > 0.0 && base > 0.0).then(|| ours / base)
+        });
+        r.ratio_to_aa_none = none
+            .get(&(key(r), r.algorithm.clone(), r.precision))
+            .map(|ms| r.median_ms / ms);
+        r.ratio_to_f32 = single
+            .get(&(key(r), r.algorithm.clone(), r.aa.clone()))
+            .map(|ms| r.median_ms / ms);
+    }
+}
+
+/// Writes results.json (`meta` plus the rows), results.csv, aa_cost.svg
+/// (when rows carry image errors) and report.html into `out`; thumbnails are
+/// read from `maps_root`. Returns the results.json text.
+fn write_outputs(
+    out: &Path,
+    meta: Value,
+    rows: &[Row],
+    maps_root: &Path,
+) -> Result<String, CliError> {
+    let mut doc = meta;
+    doc["rows"] = serde_json::to_value(rows).context("encoding results")?;
+    let text = serde_json::to_string_pretty(&doc).context("encoding results")?;
+    std::fs::write(out.join("results.json"), &text).context("writing results.json")?;
+    write_csv(&out.join("results.csv"), rows)?;
+    let points: Vec<AaPoint> = rows
+        .iter()
+        .filter_map(|r| {
+            Some(AaPoint {
+                scene: r.scene.clone(),
+                algorithm: r.algorithm.clone(),
+                aa: r.aa.clone(),
+                median_ms: r.median_ms,
+                flip_mean: r.flip_mean?,
+            })
+        })
+        .collect();
+    let aa_svg = (!points.is_empty()).then(|| aa_cost_svg(&points));
+    if let Some(svg) = &aa_svg {
+        let path = out.join("aa_cost.svg");
+        std::fs::write(&path, svg).with_context(|| format!("writing {}", path.display()))?;
+    }
+    let html = report::report_html(&doc, rows, maps_root, aa_svg.as_deref());
+    std::fs::write(out.join("report.html"), html).context("writing report.html")?;
+    Ok(text)
+}
+
+/// `continuum compare merge`: the shards' rows together, their relations
+/// computed again, their thumbnails copied, one report.
+fn merge(args: &MergeArgs) -> Result<(), CliError> {
+    let mut rows: Vec<Row> = Vec::new();
+    let mut shards = Vec::new();
+    let mut sweep: Option<Value> = None;
+    let mut seen: Vec<Value> = Vec::new();
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    for dir in &args.shards {
+        let path = dir.join("results.json");
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| CliError::Usage(format!("{}: {e}", path.display())))?;
+        let doc: Value = serde_json::from_str(&text)
+            .map_err(|e| CliError::Usage(format!("{}: {e}", path.display())))?;
+        let this_sweep = doc.get("sweep").cloned().unwrap_or(Value::Null);
+        match &sweep {
+            None => sweep = Some(this_sweep),
+            Some(s) if *s != this_sweep => {
+                return Err(CliError::Usage(format!(
+                    "{}: a shard of another sweep ({this_sweep} against {s})",
+                    path.display()
+                )));
+            }
+            Some(_) => {}
+        }
+        let shard = doc.get("shard").cloned().unwrap_or(Value::Null);
+        if !shard.is_null() && seen.contains(&shard) {
+            return Err(CliError::Usage(format!(
+                "{}: shard {shard} given twice",
+                path.display()
+            )));
+        }
+        seen.push(shard.clone());
+        let part: Vec<Row> = serde_json::from_value(doc["rows"].clone())
+            .map_err(|e| CliError::Usage(format!("{}: rows: {e}", path.display())))?;
+        for row in &part {
+            if let Some(map) = &row.map {
+                let (from, to) = (dir.join(map), args.out.join(map));
+                if let Some(parent) = to.parent() {
+                    std::fs::create_dir_all(parent)
+                        .with_context(|| format!("creating {}", parent.display()))?;
+                }
+                if from != to {
+                    std::fs::copy(&from, &to)
+                        .with_context(|| format!("copying {}", from.display()))?;
+                }
+            }
+        }
+        rows.extend(part);
+        shards.push(json!({ "dir": dir.display().to_string(), "machine": doc["machine"], "command": doc["command"], "shard": shard }));
+    }
+    // Every part of the sweep must be there.
+    if let Some(count) = seen.iter().find_map(|s| s["count"].as_u64()) {
+        let missing: Vec<u64> = (0..count)
+            .filter(|i| !seen.iter().any(|s| s["index"].as_u64() == Some(*i)))
+            .collect();
+        if !missing.is_empty() {
+            return Err(CliError::Usage(format!(
+                "shards {missing:?} of {count} are missing"
+            )));
+        }
+    }
+    rows.sort_by_key(|r| r.cell);
+    relate(&mut rows);
+    let meta = json!({
+        "machine": shards.first().map_or(Value::Null, |s| s["machine"].clone()),
+        "command": std::env::args().collect::<Vec<_>>().join(" "),
+        "sweep": sweep.unwrap_or(Value::Null),
+        "shards": shards,
+    });
+    write_outputs(&args.out, meta, &rows, &args.out)?;
+    write_stdout(&table_text(&rows))?;
+    Ok(())
+}
+
+/// The machine a run measured on: CPU, cores, threads, OS, the GPU adapter
+/// (when built with it and one opens) and continuum's version.
+fn machine(threads: usize) -> Value {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into());
+    json!({
+        "cpu": cpu,
+        "logical_cores": std::thread::available_parallelism().map_or(0, |n| n.get()),
+        "threads": threads,
+        "os": std::env::consts::OS,
+        "arch": std::env::consts::ARCH,
+        "continuum_version": env!("CARGO_PKG_VERSION"),
+        "gpu": gpu_adapter(),
+        "lp_num_threads": std::env::var("LP_NUM_THREADS").ok(),
+    })
+}
+
+fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
+    let mut f =
+        std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
+    let mut text = String::from(
+        "scene,algorithm,camera,viewport,aa,precision,width,height,threads,median_ms,min_ms,max_ms,ratio_to_2dr_brute,predicted_ratio,rays_per_second,triangle_setups,edge_evaluations,bvh_nodes_visited,agrees,pixels_differing_from_3dr_brute,triangle_id_hash,ratio_to_aa_none,ratio_to_f32,shading_samples,coverage_samples,psnr,psnr_edges,flip_mean\n",
+    );
+    let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.4}"));
+    for r in rows {
+        let stat = |k: &str| {
+            r.stats
+                .get(k)
+                .and_then(Value::as_u64)
+                .map_or(String::new(), |v| v.to_string())
+        };
+        text.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{:.0},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            r.scene,
+            r.algorithm,
+            r.camera,
+            r.viewport,
+            r.aa,
+            r.precision,
+            r.width,
+            r.height,
+            r.threads,
+            r.median_ms,
+            r.min_ms,
+            r.max_ms,
+            opt(r.ratio_to_2dr_brute),
+            opt(r.predicted_ratio),
+            r.rays_per_second,
+            stat("triangle_setups"),
+            stat("edge_evaluations"),
+            stat("bvh_nodes_visited"),
+            r.agrees,
+            r.pixels_differing_from_3dr_brute
+                .map_or(String::new(), |v| v.to_string()),
+            r.hashes
+                .get("triangle_id")
+                .and_then(Value::as_str)
+                .unwrap_or(""),
+            opt(r.ratio_to_aa_none),
+            opt(r.ratio_to_f32),
+            r.shading_samples,
+            r.coverage_samples,
+            opt(r.psnr),
+            opt(r.psnr_edges),
+            r.flip_mean.map_or(String::new(), |v| format!("{v:.6}")),
+        ));
+    }
+    f.write_all(text.as_bytes())
+        .context("writing results.csv")?;
+    Ok(())
+}
+
+/// The rows as a table for the terminal.
+fn table_text(rows: &[Row]) -> String {
+    use std::fmt::Write;
+    let mut out = String::new();
+    writeln!(
+        out,
+        "{:<12} {:<18} {:<16} {:<10} {:<5} {:>10} {:>8} {:>9} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
+        "scene",
+        "algorithm",
+        "viewport",
+        "aa",
+        "prec",
+        "median ms",
+        "ratio",
+        "predicted",
+        "x none",
+        "x f32",
+        "PSNR dB",
+        "edges dB",
+        "FLIP",
+        "agrees"
+    )
+    .ok();
+    for r in rows {
+        let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.2}"));
+        writeln!(
+            out,
+            "{:<12} {:<18} {:<16} {:<10} {:<5} {:>10.2} {:>8} {:>9} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
+            r.scene,
+            r.algorithm,
+            r.viewport,
+            r.aa,
+            r.precision,
+            r.median_ms,
+            opt(r.ratio_to_2dr_brute),
+            opt(r.predicted_ratio),
+            opt(r.ratio_to_aa_none),
+            opt(r.ratio_to_f32),
+            opt(r.psnr),
+            opt(r.psnr_edges),
+            r.flip_mean.map_or("-".to_string(), |v| format!("{v:.4}")),
+            match r.pixels_differing_from_3dr_brute {
+                Some(d) => format!("{d} px"),
+                None => r.agrees.to_string(),
+            }
+        )
+        .ok();
+    }
+    out
+}
+
+#[cfg(feature = "gpu")]
+fn gpu_adapter() -> Option<String> {
+    continuum::gpu::gpu().ok().map(|g| g.adapter.clone())
+}
+
+#[cfg(not(feature = "gpu"))]
+fn gpu_adapter() -> Option<String> {
+    None
+}

@@ -1,0 +1,327 @@
+//! `report.html`: one self-contained page (inline SVG plots and base64
+//! thumbnails, no scripts or fonts to fetch) from a comparison's rows: the
+//! paper's Fig. 9 (time and predicted instructions relative to `2dr-brute`, per
+//! scene), the edge-evaluation maps side by side (Fig. 1 right), accuracy
+//! against time for anti-aliasing, the peers, agreement, every row, and the
+//! machine and command that produced them.
+
+use std::fmt::Write;
+use std::path::Path;
+
+use base64::Engine;
+use serde_json::Value;
+
+use super::Row;
+
+const COLORS: [&str; 2] = ["#1f77b4", "#ff7f0e"];
+
+/// The report for `rows` (thumbnails read relative to `maps_root`), with the
+/// anti-aliasing chart when there is one; `doc` holds the machine, command,
+/// sweep and shards.
+pub fn report_html(doc: &Value, rows: &[Row], maps_root: &Path, aa_svg: Option<&str>) -> String {
+    let mut h = String::new();
+    let _ = write!(
+        h,
+        r#"<!doctype html>
+<html lang="en"><head><meta charset="utf-8"><title>continuum comparison</title>
+<style>
+body {{ font-family: sans-serif; margin: 24px; color: #222; max-width: 1400px; }}
+h1 {{ font-size: 22px; }} h2 {{ font-size: 18px; margin-top: 32px; border-bottom: 1px solid #ccc; }}
+h3 {{ font-size: 15px; }}
+table {{ border-collapse: collapse; font-size: 12px; }}
+td, th {{ border: 1px solid #ddd; padding: 3px 6px; text-align: right; }}
+th {{ background: #f4f4f4; }} td.l, th.l {{ text-align: left; }}
+.bad {{ background: #fdd; }} .good {{ background: #dfd; }}
+.maps {{ display: flex; flex-wrap: wrap; gap: 10px; }}
+.maps figure {{ margin: 0; font-size: 11px; text-align: center; }}
+.maps img {{ image-rendering: pixelated; border: 1px solid #ccc; }}
+pre {{ background: #f7f7f7; padding: 8px; font-size: 11px; overflow-x: auto; }}
+</style></head><body>
+<h1>continuum comparison</h1>
+<p>{} rows over {} scenes. Times are medians over repeats; ratios are to <code>2dr-brute</code> of the same scene, viewport and mode (the paper's Fig. 9).</p>
+"#,
+        rows.len(),
+        distinct(rows.iter().map(|r| r.scene.as_str())).len()
+    );
+    fig9(&mut h, rows);
+    edge_maps(&mut h, rows, maps_root);
+    if let Some(svg) = aa_svg {
+        let _ = write!(
+            h,
+            "<h2 id=\"aa\">Anti-aliasing: accuracy against time</h2>\n<p>Mean FLIP against a <code>ssaa:256</code> reference, time on a log scale; dashed: the Pareto front.</p>\n{svg}\n"
+        );
+    }
+    peers(&mut h, rows);
+    agreement(&mut h, rows);
+    all_rows(&mut h, rows);
+    let _ = write!(
+        h,
+        "<h2 id=\"machine\">Machine, command, versions</h2>\n<pre>{}</pre>\n</body></html>\n",
+        escape(&serde_json::to_string_pretty(&meta_without_rows(doc)).unwrap_or_default())
+    );
+    h
+}
+
+fn meta_without_rows(doc: &Value) -> Value {
+    let mut meta = doc.clone();
+    if let Some(map) = meta.as_object_mut() {
+        map.remove("rows");
+    }
+    meta
+}
+
+fn distinct<'a>(items: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
+    let mut out: Vec<&str> = Vec::new();
+    for i in items {
+        if !out.contains(&i) {
+            out.push(i);
+        }
+    }
+    out
+}
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+fn opt(v: Option<f64>, digits: usize) -> String {
+    v.map_or("–".into(), |x| format!("{x:.digits$}"))
+}
+
+/// Rows of one group (scene, viewport, camera, mode and precision), in order.
+fn groups(rows: &[Row]) -> Vec<Vec<&Row>> {
+    let mut out: Vec<Vec<&Row>> = Vec::new();
+    for r in rows {
+        match out.iter_mut().find(|g| {
+            let f = g[0];
+            (&f.scene, &f.viewport, &f.camera, &f.aa, f.precision)
+                == (&r.scene, &r.viewport, &r.camera, &r.aa, r.precision)
+        }) {
+            Some(g) => g.push(r),
+            None => out.push(vec![r]),
+        }
+    }
+    out
+}
+
+/// Fig. 9: per scene, each algorithm's time (measured) and predicted
+/// instructions relative to 2dr-brute, as horizontal bars around 1.
+fn fig9(h: &mut String, rows: &[Row]) {
+    let _ = writeln!(
+        h,
+        "<h2 id=\"fig9\">Time relative to 2dr-brute (paper Fig. 9)</h2>\n<p><span style=\"color:{}\">■</span> measured time ratio, <span style=\"color:{}\">■</span> predicted-instruction ratio from the paper's Fig. 10 costs. Below 1 is faster than 2dr-brute.</p>",
+        COLORS[0], COLORS[1]
+    );
+    for group in groups(rows) {
+        let bars: Vec<&&Row> = group
+            .iter()
+            .filter(|r| r.ratio_to_2dr_brute.is_some())
+            .collect();
+        if bars.is_empty() {
+            continue;
+        }
+        let f = group[0];
+        let _ = writeln!(
+            h,
+            "<h3>{} — {} {} {} {}×{}</h3>",
+            escape(&f.scene),
+            escape(&f.viewport),
+            escape(&f.aa),
+            f.precision,
+            f.width,
+            f.height
+        );
+        let max = bars
+            .iter()
+            .flat_map(|r| [r.ratio_to_2dr_brute, r.predicted_ratio])
+            .flatten()
+            .fold(1.0f64, f64::max)
+            .min(20.0);
+        let (label_w, plot_w, row_h) = (170.0, 520.0, 26.0);
+        let height = bars.len() as f64 * row_h + 30.0;
+        let x = |v: f64| label_w + plot_w * (v.min(max) / max);
+        let _ = writeln!(
+            h,
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{}" height="{height}" font-family="sans-serif" font-size="11">"#,
+            label_w + plot_w + 120.0
+        );
+        for (k, r) in bars.iter().enumerate() {
+            let y = 10.0 + k as f64 * row_h;
+            let _ = writeln!(
+                h,
+                r#"<text x="{}" y="{}" text-anchor="end">{}</text>"#,
+                label_w - 6.0,
+                y + 14.0,
+                escape(&r.algorithm)
+            );
+            for (j, v) in [r.ratio_to_2dr_brute, r.predicted_ratio]
+                .into_iter()
+                .enumerate()
+            {
+                let Some(v) = v else { continue };
+                let yy = y + j as f64 * 10.0 + 2.0;
+                let _ = writeln!(
+                    h,
+                    r#"<rect x="{label_w}" y="{yy}" width="{:.1}" height="9" fill="{}"><title>{}: {v:.3}</title></rect><text x="{:.1}" y="{:.1}">{v:.2}</text>"#,
+                    (x(v) - label_w).max(0.5),
+                    COLORS[j],
+                    if j == 0 {
+                        "time ratio"
+                    } else {
+                        "predicted ratio"
+                    },
+                    x(v) + 3.0,
+                    yy + 8.0
+                );
+            }
+        }
+        let one = x(1.0);
+        let _ = writeln!(
+            h,
+            r##"<line x1="{one:.1}" y1="4" x2="{one:.1}" y2="{:.1}" stroke="#444" stroke-dasharray="3,3"/><text x="{one:.1}" y="{:.1}" text-anchor="middle">1</text></svg>"##,
+            height - 16.0,
+            height - 4.0
+        );
+    }
+}
+
+/// Fig. 1 right: every algorithm's edge evaluations per pixel, side by side.
+fn edge_maps(h: &mut String, rows: &[Row], maps_root: &Path) {
+    let _ = writeln!(
+        h,
+        "<h2 id=\"maps\">Edge evaluations per pixel (paper Fig. 1 right)</h2>\n<p>Inferno scale, logarithmic: a pixel with n evaluations sits at ln(1+n)/ln(1+max), black = none; max is per image.</p>"
+    );
+    for group in groups(rows) {
+        let with_maps: Vec<&&Row> = group.iter().filter(|r| r.map.is_some()).collect();
+        if with_maps.is_empty() {
+            continue;
+        }
+        let f = group[0];
+        let _ = writeln!(
+            h,
+            "<h3>{} — {} {} {}</h3>\n<div class=\"maps\">",
+            escape(&f.scene),
+            escape(&f.viewport),
+            escape(&f.aa),
+            f.precision
+        );
+        for r in with_maps {
+            let Some(map) = &r.map else { continue };
+            let Ok(bytes) = std::fs::read(maps_root.join(map)) else {
+                continue;
+            };
+            let data = base64::engine::general_purpose::STANDARD.encode(bytes);
+            let _ = writeln!(
+                h,
+                r#"<figure><img alt="{0}" src="data:image/png;base64,{data}"><figcaption>{0}: max {1}, {2} evaluations</figcaption></figure>"#,
+                escape(&r.algorithm),
+                r.stats["max_edge_evals_per_pixel"],
+                r.stats["edge_evaluations"]
+            );
+        }
+        h.push_str("</div>\n");
+    }
+}
+
+/// The peers beside the ray caster and the fastest of continuum's own.
+fn peers(h: &mut String, rows: &[Row]) {
+    let peer = |r: &Row| r.algorithm.starts_with("peer-") || r.algorithm == "gpu-raster";
+    if !rows.iter().any(peer) {
+        return;
+    }
+    h.push_str("<h2 id=\"peers\">Peers</h2>\n<p>peer-obvhs (obvhs's own traversal and triangle test), peer-embree (one rtcIntersect1 per ray), peer-embree-stream (coherent row streams), gpu-raster (the GPU's pipeline through wgpu; lavapipe without a GPU) beside raycast and 3dr-full. Peers are not watertight: their pixels differing from 3dr-brute are reported, not asserted.</p>\n<table><tr><th class=\"l\">scene</th><th class=\"l\">algorithm</th><th>median ms</th><th>× 2dr-brute</th><th>Mrays/s</th><th>pixels ≠ 3dr-brute</th></tr>\n");
+    for group in groups(rows) {
+        if !group.iter().any(|r| peer(r)) {
+            continue;
+        }
+        for r in group
+            .iter()
+            .filter(|r| peer(r) || r.algorithm == "raycast" || r.algorithm == "3dr-full")
+        {
+            let _ = writeln!(
+                h,
+                "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{:.2}</td><td>{}</td><td>{:.2}</td><td>{}</td></tr>",
+                escape(&r.scene),
+                escape(&r.algorithm),
+                r.median_ms,
+                opt(r.ratio_to_2dr_brute, 2),
+                r.rays_per_second / 1e6,
+                r.pixels_differing_from_3dr_brute
+                    .map_or("–".into(), |d| d.to_string())
+            );
+        }
+    }
+    h.push_str("</table>\n");
+}
+
+/// Does every algorithm agree with its family (continuum's own: bit for bit)?
+fn agreement(h: &mut String, rows: &[Row]) {
+    let algorithms = distinct(rows.iter().map(|r| r.algorithm.as_str()));
+    h.push_str("<h2 id=\"agreement\">Agreement</h2>\n<p>✓: the triangle ids (per sample with anti-aliasing) equal the family's first member's bit for bit; for peers and gpu-raster, equal 3dr-brute's. A ✗ on one of continuum's own algorithms is a bug.</p>\n<table><tr><th class=\"l\">scene / viewport / aa / precision</th>");
+    for a in &algorithms {
+        let _ = write!(h, "<th>{}</th>", escape(a));
+    }
+    h.push_str("</tr>\n");
+    for group in groups(rows) {
+        let f = group[0];
+        let _ = write!(
+            h,
+            "<tr><td class=\"l\">{} / {} / {} / {}</td>",
+            escape(&f.scene),
+            escape(&f.viewport),
+            escape(&f.aa),
+            f.precision
+        );
+        for a in &algorithms {
+            match group.iter().find(|r| r.algorithm == *a) {
+                None => h.push_str("<td></td>"),
+                Some(r) if r.agrees => h.push_str("<td class=\"good\">✓</td>"),
+                Some(r) => {
+                    let _ = write!(
+                        h,
+                        "<td class=\"bad\">✗{}</td>",
+                        r.pixels_differing_from_3dr_brute
+                            .map_or(String::new(), |d| format!(" {d} px"))
+                    );
+                }
+            }
+        }
+        h.push_str("</tr>\n");
+    }
+    h.push_str("</table>\n");
+}
+
+fn all_rows(h: &mut String, rows: &[Row]) {
+    h.push_str("<h2 id=\"rows\">Every row</h2>\n<table><tr><th class=\"l\">scene</th><th class=\"l\">algorithm</th><th class=\"l\">viewport</th><th class=\"l\">aa</th><th class=\"l\">prec.</th><th>median ms</th><th>min</th><th>max</th><th>× 2dr-brute</th><th>predicted</th><th>× aa none</th><th>× f32</th><th>setups</th><th>edge evals</th><th>PSNR</th><th>FLIP</th></tr>\n");
+    for r in rows {
+        let stat = |k: &str| {
+            r.stats
+                .get(k)
+                .and_then(Value::as_u64)
+                .map_or("–".into(), |v| v.to_string())
+        };
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{:.2}</td><td>{:.2}</td><td>{:.2}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            escape(&r.scene),
+            escape(&r.algorithm),
+            escape(&r.viewport),
+            escape(&r.aa),
+            r.precision,
+            r.median_ms,
+            r.min_ms,
+            r.max_ms,
+            opt(r.ratio_to_2dr_brute, 2),
+            opt(r.predicted_ratio, 2),
+            opt(r.ratio_to_aa_none, 2),
+            opt(r.ratio_to_f32, 2),
+            stat("triangle_setups"),
+            stat("edge_evaluations"),
+            opt(r.psnr, 2),
+            opt(r.flip_mean, 4)
+        );
+    }
+    h.push_str("</table>\n");
+}

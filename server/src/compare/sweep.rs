@@ -1,0 +1,284 @@
+//! What a comparison run covers: the sweep (scenes × viewports × anti-aliasing
+//! modes × precisions × algorithms), from flags or a sweep file, cut into
+//! cells — one scene, viewport, mode and precision with every algorithm that
+//! serves it — and into disjoint shards of cells.
+//!
+//! A sweep file (`continuum compare --sweep sweep.toml`):
+//! ```toml
+//! scenes = ["teapots", "bunny", "../shared/scenes/dragon/dragon_vrip_res2.glb"]
+//! algorithms = ["2dr-brute", "3dr-full", "raycast", "gpu-raster", "peer-obvhs"]  # default: all
+//! viewports = ["camera", "orthographic", "parabolic"]   # default: the camera's own
+//! aa = ["none", "msaa:4"]                              # default: none
+//! precision = ["f32", "f64"]                           # default: f32
+//! size = "1280x720"
+//! repeat = 3
+//! threads = 2                                          # default: all cores
+//! camera = "front"                                     # default: each scene's first
+//! ```
+//! Unknown keys and bad values are errors naming the key.
+
+use std::path::Path;
+
+use continuum::peer::PeerId;
+use continuum::request::{parse_algorithm, parse_size};
+use continuum::{AaMode, AlgorithmId, Precision, Viewport};
+use serde::{Deserialize, Serialize};
+
+use crate::CliError;
+
+/// The sweep file's keys; every one optional but `scenes`.
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SweepFile {
+    pub scenes: Vec<String>,
+    pub algorithms: Option<Vec<String>>,
+    pub viewports: Option<Vec<String>>,
+    pub aa: Option<Vec<String>>,
+    pub precision: Option<Vec<String>>,
+    pub size: Option<String>,
+    pub repeat: Option<u32>,
+    pub threads: Option<u32>,
+    pub camera: Option<String>,
+}
+
+/// What one row measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Entry {
+    Algorithm(AlgorithmId),
+    Peer(PeerId),
+}
+
+impl Entry {
+    pub fn name(self) -> &'static str {
+        match self {
+            Entry::Algorithm(a) => a.as_str(),
+            Entry::Peer(p) => p.as_str(),
+        }
+    }
+}
+
+/// A viewport as a sweep names it: the camera's own, or one in the CLI's words
+/// (bare `orthographic` frames what the camera's field of view shows at its
+/// target).
+#[derive(Clone, Debug, PartialEq)]
+pub enum ViewportChoice {
+    Camera,
+    Named(String),
+}
+
+impl ViewportChoice {
+    /// The camera's viewport under this choice.
+    pub fn apply(&self, camera: &continuum::Camera) -> Result<Viewport, CliError> {
+        match self {
+            ViewportChoice::Camera => Ok(camera.viewport),
+            ViewportChoice::Named(text) if text.trim() == "orthographic" => {
+                let height = match camera.viewport {
+                    Viewport::Orthographic { height } => height,
+                    Viewport::Perspective { fov_y_deg } => {
+                        2.0 * (camera.target - camera.eye).length()
+                            * (fov_y_deg.to_radians() * 0.5).tan()
+                    }
+                    _ => 2.0 * (camera.target - camera.eye).length(),
+                };
+                Ok(Viewport::Orthographic { height })
+            }
+            ViewportChoice::Named(text) => continuum::request::parse_viewport(text, camera)
+                .map_err(|e| CliError::Usage(format!("viewports: {}", e.message))),
+        }
+    }
+}
+
+/// A checked sweep.
+#[derive(Clone, Debug)]
+pub struct Sweep {
+    pub scenes: Vec<String>,
+    pub entries: Vec<Entry>,
+    pub viewports: Vec<ViewportChoice>,
+    pub aa: Vec<AaMode>,
+    /// f32 first: the other precisions' rows relate to its times.
+    pub precisions: Vec<Precision>,
+    pub size: (u32, u32),
+    pub repeat: u32,
+    pub threads: Option<u32>,
+    pub camera: Option<String>,
+    /// Is any mode not `none` (then every scene gets an `ssaa:256` reference)?
+    pub with_reference: bool,
+    /// The file's text form (for results.json).
+    pub file: SweepFile,
+}
+
+/// Parses a sweep file; errors name the file and the key.
+pub fn read_sweep_file(path: &Path) -> Result<SweepFile, CliError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| CliError::Usage(format!("--sweep: {}: {e}", path.display())))?;
+    toml::from_str(&text).map_err(|e| CliError::Usage(format!("--sweep: {}: {e}", path.display())))
+}
+
+impl Sweep {
+    /// Checks every key of `file`; `builtin` lists the scenes when it names none.
+    pub fn new(file: SweepFile, builtin: impl FnOnce() -> Vec<String>) -> Result<Sweep, CliError> {
+        let bad = |key: &str, m: String| CliError::Usage(format!("{key}: {m}"));
+        let scenes = if file.scenes.is_empty() {
+            builtin()
+        } else {
+            file.scenes.clone()
+        };
+        let entries = parse_entries(file.algorithms.as_deref().unwrap_or_default())?;
+        let viewports = match &file.viewports {
+            None => vec![ViewportChoice::Camera],
+            Some(list) if list.is_empty() => return Err(bad("viewports", "is empty".into())),
+            Some(list) => list
+                .iter()
+                .map(|v| {
+                    if v == "camera" {
+                        return Ok(ViewportChoice::Camera);
+                    }
+                    // The words now; bare `orthographic` is framed per camera.
+                    Viewport::parse(v, Viewport::Orthographic { height: 1.0 })
+                        .map_err(|e| bad("viewports", e.message))?;
+                    Ok(ViewportChoice::Named(v.clone()))
+                })
+                .collect::<Result<_, CliError>>()?,
+        };
+        let aa = match &file.aa {
+            None => vec![AaMode::None],
+            Some(list) => list
+                .iter()
+                .map(|s| AaMode::parse(s).map_err(|e| bad("aa", e.message)))
+                .collect::<Result<Vec<_>, _>>()?,
+        };
+        let precisions: Vec<Precision> = match &file.precision {
+            None => vec![Precision::F32],
+            Some(list) => {
+                let parsed = list
+                    .iter()
+                    .map(|s| Precision::parse(s).map_err(|e| bad("precision", e.message)))
+                    .collect::<Result<Vec<_>, _>>()?;
+                Precision::ALL
+                    .into_iter()
+                    .filter(|p| parsed.contains(p))
+                    .collect()
+            }
+        };
+        if aa.is_empty() || precisions.is_empty() {
+            return Err(bad("aa/precision", "an empty list".into()));
+        }
+        let size = match &file.size {
+            None => (1280, 720),
+            Some(s) => parse_size(s).map_err(|e| bad("size", e.message))?,
+        };
+        let repeat = file.repeat.unwrap_or(3);
+        if !(1..=1000).contains(&repeat) {
+            return Err(bad("repeat", format!("{repeat} is not in 1..=1000")));
+        }
+        if let Some(t) = file.threads
+            && !(1..=1024).contains(&t)
+        {
+            return Err(bad("threads", format!("{t} is not in 1..=1024")));
+        }
+        Ok(Sweep {
+            scenes,
+            entries,
+            viewports,
+            with_reference: aa.iter().any(|&m| m != AaMode::None),
+            aa,
+            precisions,
+            size,
+            repeat,
+            threads: file.threads,
+            camera: file.camera.clone(),
+            file,
+        })
+    }
+
+    /// Every cell in plan order: scene, viewport, mode, precision.
+    pub fn cells(&self) -> Vec<Cell> {
+        let mut cells = Vec::new();
+        for scene in &self.scenes {
+            for viewport in &self.viewports {
+                for &aa in &self.aa {
+                    for &precision in &self.precisions {
+                        cells.push(Cell {
+                            index: cells.len(),
+                            scene: scene.clone(),
+                            viewport: viewport.clone(),
+                            aa,
+                            precision,
+                        });
+                    }
+                }
+            }
+        }
+        cells
+    }
+}
+
+/// One scene, viewport, anti-aliasing mode and precision: its algorithms run
+/// together (their agreement is decided within the cell).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cell {
+    pub index: usize,
+    pub scene: String,
+    pub viewport: ViewportChoice,
+    pub aa: AaMode,
+    pub precision: Precision,
+}
+
+/// `I/N`: part `I` (0-based, as Kubernetes' `JOB_COMPLETION_INDEX`) of `N`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Shard {
+    pub index: u32,
+    pub count: u32,
+}
+
+impl Shard {
+    pub fn parse(s: &str) -> Result<Shard, String> {
+        let bad = || format!("'{s}' is not I/N with 0 <= I < N, e.g. 0/4");
+        let (i, n) = s.split_once('/').ok_or_else(bad)?;
+        let (index, count): (u32, u32) = (
+            i.trim().parse().map_err(|_| bad())?,
+            n.trim().parse().map_err(|_| bad())?,
+        );
+        if count == 0 || index >= count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// Does this shard run `cell`? Cells are dealt round-robin, so shards get
+    /// a mix of scenes and modes.
+    pub fn takes(self, cell: &Cell) -> bool {
+        cell.index % self.count as usize == self.index as usize
+    }
+}
+
+/// Algorithm ids and peers; empty means every algorithm and every peer this
+/// binary was built with.
+pub fn parse_entries(names: &[String]) -> Result<Vec<Entry>, CliError> {
+    if names.is_empty() {
+        let mut all: Vec<Entry> = AlgorithmId::ALL.into_iter().map(Entry::Algorithm).collect();
+        all.extend(
+            PeerId::ALL
+                .into_iter()
+                .filter(|p| p.available())
+                .map(Entry::Peer),
+        );
+        return Ok(all);
+    }
+    names
+        .iter()
+        .map(|n| match PeerId::parse(n) {
+            Some(p) if !p.available() => Err(CliError::Usage(format!(
+                "algorithms: {n} needs continuum built with --features embree (and Debian's libembree-dev)"
+            ))),
+            Some(p) => Ok(Entry::Peer(p)),
+            None => parse_algorithm(n).map(Entry::Algorithm).map_err(|e| {
+                CliError::Usage(format!(
+                    "algorithms: {}; peers are: {}",
+                    e.message,
+                    PeerId::ALL.map(|p| p.as_str()).join(", ")
+                ))
+            }),
+        })
+        .collect()
+}
