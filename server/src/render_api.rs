@@ -339,8 +339,17 @@ pub async fn algorithms() -> Json<Value> {
                     .filter(|v| v.serves(*a))
                     .map(Viewport::kind)
                     .collect::<Vec<_>>(),
-                "takes_oracles": a.pipeline() != continuum::Pipeline::Rays,
-                "aa": AaMode::all().iter().map(ToString::to_string).collect::<Vec<_>>(),
+                "takes_oracles": !matches!(a.pipeline(), continuum::Pipeline::Rays | continuum::Pipeline::Gpu),
+                "aa": AaMode::all()
+                    .iter()
+                    .filter(|m| *a != AlgorithmId::GpuRaster || **m == AaMode::None)
+                    .map(ToString::to_string)
+                    .collect::<Vec<_>>(),
+                "precisions": Precision::ALL
+                    .iter()
+                    .filter(|p| p.serves(a.family()))
+                    .map(|p| p.as_str())
+                    .collect::<Vec<_>>(),
             })
         })
         .collect();

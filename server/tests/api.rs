@@ -316,6 +316,18 @@ fn bad_input_is_a_4xx_naming_the_field() {
             "viewport",
         ),
         (
+            r#"{ "scene": "box", "algorithm": "2dr-bin", "precision": "f64" }"#,
+            "precision",
+        ),
+        (
+            r#"{ "scene": "box", "algorithm": "raycast", "precision": "f16" }"#,
+            "precision",
+        ),
+        (
+            r#"{ "scene": "box", "algorithm": "gpu-raster", "aa": "msaa:4" }"#,
+            "aa",
+        ),
+        (
             r#"{ "scene": "box", "algorithm": "raycast", "aa": "msaa:99" }"#,
             "aa",
         ),

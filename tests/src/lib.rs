@@ -76,22 +76,10 @@ pub fn render_aa(
     scene: &PreparedScene,
     algorithm: AlgorithmId,
     camera: &Camera,
-    (width, height): (u32, u32),
+    size: (u32, u32),
     aa: continuum::AaMode,
 ) -> RenderOutput {
-    render(
-        scene,
-        &RenderRequest {
-            algorithm,
-            oracles: None,
-            camera: camera.clone(),
-            width,
-            height,
-            aa,
-            precision: Default::default(),
-        },
-    )
-    .unwrap_or_else(|e| panic!("{algorithm} {aa}: {e}"))
+    render_full(scene, algorithm, camera, size, aa, Default::default())
 }
 
 /// Renders at `precision` (one sample per pixel), panicking on error.
@@ -99,7 +87,26 @@ pub fn render_precise(
     scene: &PreparedScene,
     algorithm: AlgorithmId,
     camera: &Camera,
+    size: (u32, u32),
+    precision: continuum::Precision,
+) -> RenderOutput {
+    render_full(
+        scene,
+        algorithm,
+        camera,
+        size,
+        continuum::AaMode::None,
+        precision,
+    )
+}
+
+/// Renders with an anti-aliasing mode and a precision, panicking on error.
+pub fn render_full(
+    scene: &PreparedScene,
+    algorithm: AlgorithmId,
+    camera: &Camera,
     (width, height): (u32, u32),
+    aa: continuum::AaMode,
     precision: continuum::Precision,
 ) -> RenderOutput {
     render(
@@ -110,11 +117,11 @@ pub fn render_precise(
             camera: camera.clone(),
             width,
             height,
-            aa: continuum::AaMode::None,
+            aa,
             precision,
         },
     )
-    .unwrap_or_else(|e| panic!("{algorithm} {precision}: {e}"))
+    .unwrap_or_else(|e| panic!("{algorithm} {aa} {precision}: {e}"))
 }
 
 /// Pixels where two triangle-id buffers differ, as `(x, y, a, b)`.
