@@ -48,8 +48,8 @@ pub struct CompareArgs {
     /// Camera name; default: each scene's first camera.
     #[arg(long)]
     camera: Option<String>,
-    /// Viewports, comma-separated: `camera` (the camera's own), perspective[:FOV],
-    /// orthographic[:HEIGHT], parabolic, latlong [default: camera].
+    /// Viewports, comma-separated: `camera` (the camera's own), `perspective[:FOV]`,
+    /// `orthographic[:HEIGHT]`, `parabolic`, `latlong` [default: camera].
     #[arg(long, value_delimiter = ',')]
     viewports: Vec<String>,
     /// Image size, WIDTHxHEIGHT [default: 1280x720].
