@@ -10,7 +10,7 @@
 //! The cases rebuild the Vulkan CTS fill-rule tests (`dEQP-VK.rasterization.fill_rules.*`)
 //! from their description — grids of rotated quads in both diagonal orders, the
 //! same with random `w`, one large rotated quad partly and fully clipped —
-//! plus ten thousand random triangles on the 1/256 grid and the Direct3D
+//! plus 210,000 random triangles on the 1/256 grid and the Direct3D
 //! top-left examples.
 
 use continuum::{
