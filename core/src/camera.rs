@@ -65,6 +65,20 @@ impl Camera {
         }
     }
 
+    /// The height an orthographic view of this camera takes to frame what it
+    /// shows at its target: its own height if orthographic, what a perspective
+    /// field of view spans at the target's distance, twice that distance else.
+    pub fn framing_height(&self) -> f32 {
+        let distance = (self.target - self.eye).length();
+        match self.viewport {
+            Viewport::Orthographic { height } => height,
+            Viewport::Perspective { fov_y_deg } => {
+                2.0 * distance * (fov_y_deg.to_radians() * 0.5).tan()
+            }
+            _ => 2.0 * distance,
+        }
+    }
+
     /// Checks every field; the error names the first one at fault.
     pub fn validate(&self) -> Result<(), CameraError> {
         for (field, v) in [("eye", self.eye), ("target", self.target), ("up", self.up)] {

@@ -9,7 +9,6 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use continuum::hardcases::{self, Check, SuiteReport};
-use continuum::{AlgorithmId, Precision};
 use serde_json::json;
 
 use std::fmt::Write;
@@ -103,15 +102,10 @@ fn tally(report: &SuiteReport) -> BTreeMap<(String, String), (u64, u64)> {
 }
 
 fn columns() -> Vec<String> {
-    let mut out = Vec::new();
-    for a in AlgorithmId::ALL {
-        for p in Precision::ALL {
-            if p.serves(a.family()) {
-                out.push(hardcases::variant_name(a, p));
-            }
-        }
-    }
-    out
+    hardcases::variants_of_all()
+        .into_iter()
+        .map(|(a, p)| hardcases::variant_name(a, p))
+        .collect()
 }
 
 fn table_json(report: &SuiteReport) -> serde_json::Value {

@@ -85,8 +85,8 @@ pub fn variant_name(algorithm: AlgorithmId, precision: Precision) -> String {
     }
 }
 
-/// Every (algorithm, precision) pair there is.
-fn variants_of_all() -> Vec<(AlgorithmId, Precision)> {
+/// Every (algorithm, precision) pair there is, in table order.
+pub fn variants_of_all() -> Vec<(AlgorithmId, Precision)> {
     AlgorithmId::ALL
         .into_iter()
         .flat_map(|a| {
@@ -200,14 +200,7 @@ impl HardCase {
                 .map(|v| Viewport::parse(v, camera.viewport).map_err(|e| e.message))
                 .collect(),
             None => {
-                let height = match camera.viewport {
-                    Viewport::Orthographic { height } => height,
-                    Viewport::Perspective { fov_y_deg } => {
-                        2.0 * (camera.target - camera.eye).length()
-                            * (fov_y_deg.to_radians() * 0.5).tan()
-                    }
-                    _ => 2.0 * (camera.target - camera.eye).length(),
-                };
+                let height = camera.framing_height();
                 let perspective = match camera.viewport {
                     p @ Viewport::Perspective { .. } => p,
                     _ => Viewport::Perspective { fov_y_deg: 60.0 },
@@ -320,18 +313,10 @@ pub struct Check {
 /// Every (algorithm, precision) that serves `viewport`: every algorithm at
 /// f32, the 3D family also at f64, the 2D family also in fixed point.
 pub fn variants(viewport: &Viewport) -> Vec<(AlgorithmId, Precision)> {
-    let mut out = Vec::new();
-    for a in AlgorithmId::ALL {
-        if !viewport.serves(a) {
-            continue;
-        }
-        for p in Precision::ALL {
-            if p.serves(a.family()) {
-                out.push((a, p));
-            }
-        }
-    }
-    out
+    variants_of_all()
+        .into_iter()
+        .filter(|&(a, _)| viewport.serves(a))
+        .collect()
 }
 
 /// Algorithms whose coverage writes count every covering triangle (no culling

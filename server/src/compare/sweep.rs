@@ -72,15 +72,9 @@ impl ViewportChoice {
         match self {
             ViewportChoice::Camera => Ok(camera.viewport),
             ViewportChoice::Named(text) if text.trim() == "orthographic" => {
-                let height = match camera.viewport {
-                    Viewport::Orthographic { height } => height,
-                    Viewport::Perspective { fov_y_deg } => {
-                        2.0 * (camera.target - camera.eye).length()
-                            * (fov_y_deg.to_radians() * 0.5).tan()
-                    }
-                    _ => 2.0 * (camera.target - camera.eye).length(),
-                };
-                Ok(Viewport::Orthographic { height })
+                Ok(Viewport::Orthographic {
+                    height: camera.framing_height(),
+                })
             }
             ViewportChoice::Named(text) => continuum::request::parse_viewport(text, camera)
                 .map_err(|e| CliError::Usage(format!("viewports: {}", e.message))),
