@@ -1,0 +1,141 @@
+//! `continuum-viewer`: the desktop viewer. The flags are `continuum render`'s
+//! for scene, camera, algorithm, viewport, aa, precision and size; with
+//! `--screenshot PATH` it renders the first frame, saves the whole window as PNG
+//! and exits.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::PoisonError;
+
+use clap::Parser;
+use continuum_viewer::images::ViewKind;
+use continuum_viewer::{Config, ViewerApp};
+use eframe::egui;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "continuum-viewer",
+    version,
+    about = "The continuum desktop viewer"
+)]
+struct Args {
+    /// A built-in scene name, or a .toml, .gltf, .glb or .obj path.
+    #[arg(long, default_value = "bunny")]
+    scene: String,
+    /// A camera of the scene (by name); default: the scene's first camera.
+    #[arg(long)]
+    camera: Option<String>,
+    /// Algorithm id (see `continuum render --help`).
+    #[arg(long, default_value = "3dr-brute")]
+    algorithm: String,
+    /// Explicit oracle settings on top of the algorithm's, e.g. outside=on,split=8.
+    #[arg(long)]
+    oracles: Option<String>,
+    /// Viewport: `perspective[:FOV]`, `orthographic[:HEIGHT]`, `parabolic` or `latlong`.
+    #[arg(long)]
+    viewport: Option<String>,
+    /// Anti-aliasing mode: none, ssaa:N, msaa:N, csaa:CxS.
+    #[arg(long, default_value = "none")]
+    aa: String,
+    /// Precision of coverage decisions: f32, f64 or fixed.
+    #[arg(long, default_value = "f32")]
+    precision: String,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "640x480")]
+    size: String,
+    /// Render threads (default: every core).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Folder of built-in scenes.
+    #[arg(long)]
+    scenes: Option<PathBuf>,
+    /// The view to open on: colour, edge-evals, depth or ids.
+    #[arg(long, default_value = "colour")]
+    view: String,
+    /// Window size in points, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x800")]
+    window: String,
+    /// Render the first frame, save a screenshot of the whole window here (PNG), exit.
+    #[arg(long)]
+    screenshot: Option<PathBuf>,
+}
+
+fn main() -> ExitCode {
+    let args = Args::parse();
+    let usage = |message: String| {
+        eprintln!("error: {message}");
+        ExitCode::from(2)
+    };
+    let mut config = match Config::from_words(
+        &args.scene,
+        args.camera.as_deref(),
+        &args.algorithm,
+        args.viewport.as_deref(),
+        &args.aa,
+        &args.precision,
+        &args.size,
+    ) {
+        Ok(c) => c,
+        Err(e) => return usage(format!("--{e}")),
+    };
+    config.method.oracles = args.oracles.clone().unwrap_or_default();
+    if let Some(t) = args.threads {
+        if t == 0 {
+            return usage("--threads: must be at least 1".into());
+        }
+        config.threads = t;
+    }
+    let view = match ViewKind::parse(&args.view) {
+        Ok(v) => v,
+        Err(e) => return usage(format!("--view: {e}")),
+    };
+    let window = match continuum::request::parse_size(&args.window) {
+        Ok((w, h)) => [w as f32, h as f32],
+        Err(e) => return usage(format!("--window: {}", e.message)),
+    };
+    let scenes_dir = args
+        .scenes
+        .clone()
+        .unwrap_or_else(continuum::scene::default_scenes_dir);
+
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("continuum")
+            .with_inner_size(window)
+            .with_drag_and_drop(true),
+        renderer: eframe::Renderer::Wgpu,
+        ..Default::default()
+    };
+    let result = std::sync::Arc::new(std::sync::Mutex::new(None));
+    let slot = std::sync::Arc::clone(&result);
+    let screenshot = args.screenshot.clone();
+    let run = eframe::run_native(
+        "continuum",
+        options,
+        Box::new(move |cc| {
+            let mut app = ViewerApp::new(&cc.egui_ctx, &scenes_dir, config);
+            app.view = view;
+            if let Some(path) = screenshot {
+                *slot.lock().unwrap_or_else(PoisonError::into_inner) =
+                    Some(app.screenshot_to(path));
+            }
+            Ok(Box::new(app))
+        }),
+    );
+    if let Err(e) = run {
+        eprintln!("error: the window could not run: {e}");
+        return ExitCode::FAILURE;
+    }
+    let Some(shot) = result.lock().unwrap_or_else(PoisonError::into_inner).take() else {
+        return ExitCode::SUCCESS;
+    };
+    let outcome = shot.lock().unwrap_or_else(PoisonError::into_inner).take();
+    match outcome {
+        Some(Ok(())) => ExitCode::SUCCESS,
+        Some(Err(message)) => usage(message),
+        None => {
+            eprintln!("error: --screenshot: the window closed before the first frame was captured");
+            ExitCode::FAILURE
+        }
+    }
+}
