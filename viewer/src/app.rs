@@ -10,7 +10,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 use continuum::{AaMode, AlgorithmId, Precision, RenderOutput, Stats, Viewport};
 use eframe::egui::{self, Color32, ColorImage, TextureHandle, TextureOptions};
 
-use crate::config::{CameraChoice, Config, ConfigError, Method, SceneSource};
+use crate::config::{CameraChoice, Config, ConfigError, Method, SceneSource, has_scene_extension};
 use crate::image_view::{self, Gesture};
 use crate::images::{self, Difference, ViewKind};
 use crate::orbit;
@@ -106,6 +106,8 @@ pub struct ViewerApp {
     error: Option<ConfigError>,
     history: History,
     scene_path: String,
+    /// A scenes folder the user opened: its scene and model files.
+    folder: Option<(PathBuf, Vec<PathBuf>)>,
     hovered: Option<(u32, u32)>,
     screenshot: Option<Screenshot>,
 }
@@ -136,6 +138,7 @@ impl ViewerApp {
             error: None,
             history: History::default(),
             scene_path: String::new(),
+            folder: None,
             hovered: None,
             screenshot: None,
         }
@@ -324,21 +327,39 @@ impl ViewerApp {
                         picked = Some(SceneSource::Builtin(name.clone()));
                     }
                 }
+                if let Some((dir, files)) = &self.folder {
+                    ui.separator();
+                    ui.label(dir.display().to_string());
+                    for file in files {
+                        let source = SceneSource::Path(file.clone());
+                        let chosen = self.config.scene == source;
+                        if ui.selectable_label(chosen, source.label()).clicked() {
+                            picked = Some(source);
+                        }
+                    }
+                }
             })
             .response
             .labelled_by(heading.id);
         ui.horizontal(|ui| {
             let field = ui.add(
                 egui::TextEdit::singleline(&mut self.scene_path)
-                    .hint_text(".gltf .glb .obj .toml path")
+                    .hint_text("a scene file or folder")
                     .desired_width(160.0),
             );
             let enter = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
-            if (ui.button("Open").clicked() || enter) && !self.scene_path.trim().is_empty() {
-                picked = Some(SceneSource::parse(self.scene_path.trim()));
+            let path = self.scene_path.trim();
+            if (ui.button("Open").clicked() || enter) && !path.is_empty() {
+                if Path::new(path).is_dir() {
+                    let files = scene_files(Path::new(path));
+                    picked = files.first().cloned().map(SceneSource::Path);
+                    self.folder = Some((PathBuf::from(path), files));
+                } else {
+                    picked = Some(SceneSource::parse(path));
+                }
             }
         });
-        ui.small("or drop a file on the window");
+        ui.small(".gltf .glb .obj .toml, or drop a file on the window");
         if let Some(scene) = picked {
             self.open_scene(scene);
         }
@@ -824,6 +845,19 @@ fn seconds(elapsed: Option<std::time::Duration>) -> String {
     elapsed.map_or_else(String::new, |d| format!("{:.1} s", d.as_secs_f64()))
 }
 
+/// The scene and model files of a folder, sorted.
+pub fn scene_files(dir: &Path) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.is_file() && has_scene_extension(p))
+        .collect();
+    files.sort();
+    files
+}
+
 /// Writes a screenshot as PNG.
 pub fn save_png(image: &ColorImage, path: &Path) -> Result<(), String> {
     let [w, h] = image.size;
@@ -832,4 +866,25 @@ pub fn save_png(image: &ColorImage, path: &Path) -> Result<(), String> {
         .ok_or_else(|| "screenshot: pixel count does not match its size".to_owned())?;
     rgba.save(path)
         .map_err(|e| format!("--screenshot: writing {}: {e}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_scenes_folder_lists_its_scene_and_model_files() {
+        let dir = continuum::scene::default_scenes_dir();
+        let files = scene_files(&dir);
+        let names: Vec<String> = files
+            .iter()
+            .map(|f| SceneSource::Path(f.clone()).label())
+            .collect();
+        assert!(names.contains(&"bunny.toml".to_owned()), "{names:?}");
+        assert!(names.windows(2).all(|w| w[0] <= w[1]), "sorted: {names:?}");
+        assert!(files.iter().all(|f| has_scene_extension(f)));
+        // The assets folder holds models (glb) and their licences (not listed).
+        let assets = scene_files(&dir.join("assets"));
+        assert!(!assets.is_empty() && assets.iter().all(|f| has_scene_extension(f)));
+    }
 }

@@ -3,10 +3,19 @@
 //! [`RenderRequest`]. The words are the CLI's (`continuum render`), parsed by
 //! the same functions in `continuum::request`.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use continuum::request::{parse_aa, parse_algorithm, parse_size, parse_viewport};
 use continuum::{AaMode, AlgorithmId, Camera, Precision, RenderRequest, Scene};
+
+/// Whether `path` names a scene file or a model the loaders read.
+pub fn has_scene_extension(path: &Path) -> bool {
+    path.extension().is_some_and(|e| {
+        ["toml", "gltf", "glb", "obj"]
+            .iter()
+            .any(|x| e.eq_ignore_ascii_case(x))
+    })
+}
 
 /// Where a scene comes from: a built-in name (in the scenes folder) or a path.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -19,11 +28,7 @@ impl SceneSource {
     /// A user's word: a path when it names a file, otherwise a built-in name.
     pub fn parse(word: &str) -> SceneSource {
         let path = PathBuf::from(word);
-        let has_extension = path.extension().is_some_and(|e| {
-            ["toml", "gltf", "glb", "obj"]
-                .iter()
-                .any(|x| e.eq_ignore_ascii_case(x))
-        });
+        let has_extension = has_scene_extension(&path);
         if has_extension || path.components().count() > 1 {
             SceneSource::Path(path)
         } else {
