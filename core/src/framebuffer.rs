@@ -115,6 +115,8 @@ pub(crate) struct ResolvedTile {
     pub histogram: CoverageHistogram,
     /// Shading evaluations made.
     pub shading_samples: u64,
+    /// What the tile's effect rays cost.
+    pub effects: crate::shade::plan::EffectCounters,
 }
 
 /// Pixels of a row the coverage kernel handles at once (its CSAA scratch).

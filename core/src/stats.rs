@@ -81,6 +81,9 @@ pub struct Stats {
     /// The paper's Fig. 10 model: setups × setup cost + edge evaluations × per-sample
     /// cost (2D 72/14, homogeneous 73/14, 3D 57/12 scalar instructions).
     pub predicted_instructions: u64,
+    /// The effects the scene called for and what each cost (empty when it
+    /// calls for none).
+    pub effects: Vec<crate::shade::plan::EffectStats>,
 }
 
 /// Hex xxh3-64 hashes of the result buffers (little-endian bytes), for comparing

@@ -618,6 +618,9 @@ impl ViewerApp {
         ui.label("history (total ms per frame)");
         timings::history_plot(ui, history);
         ui.add_space(6.0);
+        ui.heading("Effects");
+        timings::effects_table(ui, &renders);
+        ui.add_space(6.0);
         ui.heading("Counters");
         timings::counters_table(ui, &renders);
     }

@@ -203,6 +203,32 @@ pub fn counters_table(ui: &mut egui::Ui, renders: &[(&str, &Stats)]) {
         });
 }
 
+/// The effects each render ran (shadow rays per light, reflection rays) and
+/// their worker time; nothing when the scene calls for none.
+pub fn effects_table(ui: &mut egui::Ui, renders: &[(&str, &Stats)]) {
+    if renders.iter().all(|(_, s)| s.effects.is_empty()) {
+        ui.label("none: the scene calls for no effect");
+        return;
+    }
+    egui::Grid::new("effects")
+        .striped(true)
+        .num_columns(3)
+        .show(ui, |ui| {
+            for (label, stats) in renders {
+                for e in &stats.effects {
+                    let name = match &e.light {
+                        Some(light) => format!("{label} {} ({light})", e.effect),
+                        None => format!("{label} {}", e.effect),
+                    };
+                    ui.label(name);
+                    ui.monospace(format!("{} rays", thousands(e.rays)));
+                    ui.monospace(format!("{:.1} ms", e.worker_ms));
+                    ui.end_row();
+                }
+            }
+        });
+}
+
 /// `1234567` as `1 234 567` (thin groups read at a glance in a table).
 pub fn thousands(n: u64) -> String {
     let digits = n.to_string();

@@ -22,6 +22,7 @@ use glam::Vec3;
 
 use crate::camera::View;
 use crate::framebuffer::{BACKGROUND, ResolvedTile, TileBuffer, wins_depth_test};
+use crate::shade::plan::EffectCounters;
 use crate::shade::{BACKGROUND_COLOR, OUTSIDE_VIEWPORT_COLOR, Shader, encode_rgb, linear_rgb};
 use crate::stats::CoverageHistogram;
 
@@ -59,6 +60,7 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
         sample_digest: Vec::new(),
         histogram: CoverageHistogram::of(&tile.coverage_writes),
         shading_samples: 0,
+        effects: EffectCounters::for_plan(shader.plan()),
     };
     for (s, writes) in tile.coverage_writes.chunks_exact(pixels).enumerate() {
         if s == 0 {
@@ -120,7 +122,7 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
                     Some(_) if id == BACKGROUND => background,
                     Some((origin, dir)) => {
                         out.shading_samples += 1;
-                        shader.shade(id, origin, dir, depth_at(s))
+                        shader.shade(id, origin, dir, depth_at(s), &mut out.effects)
                     }
                 };
             }

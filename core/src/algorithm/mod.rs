@@ -405,6 +405,7 @@ pub(crate) fn run(
     stats.counters = pass.counters;
     stats.coverage_histogram = pass.histogram;
     stats.shading_samples = pass.shading_samples;
+    stats.effects = pass.effects.report(context.shader.plan(), &scene.scene);
 }
 
 /// The Fig. 7 traversal, one initial frustum per parallel work item, leaf
@@ -531,6 +532,7 @@ pub(crate) struct Pass {
     pub counters: RasterCounters,
     pub histogram: CoverageHistogram,
     pub shading_samples: u64,
+    pub effects: crate::shade::plan::EffectCounters,
     render_s: f64,
     resolve_s: f64,
 }
@@ -542,6 +544,7 @@ impl Pass {
         self.counters += finished.result;
         self.histogram += finished.resolved.histogram;
         self.shading_samples += finished.resolved.shading_samples;
+        self.effects.add(&finished.resolved.effects);
         self.render_s += finished.render_s;
         self.resolve_s += finished.resolve_s;
     }

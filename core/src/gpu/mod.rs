@@ -480,7 +480,9 @@ pub(crate) fn render_gpu_raster(
     tile.triangle_id = samples.triangle_id;
     tile.depth = samples.depth;
     tile.coverage_writes = samples.fragments.into_iter().map(u32::from).collect();
-    let resolved = resolve_tile(&tile, view, &Shader::new(scene));
+    let shader = Shader::new(scene);
+    let resolved = resolve_tile(&tile, view, &shader);
+    stats.effects = resolved.effects.report(shader.plan(), &scene.scene);
     stats.coverage_histogram = resolved.histogram;
     stats.shading_samples = resolved.shading_samples;
     fb.store(&resolved);

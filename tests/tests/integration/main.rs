@@ -3,6 +3,7 @@
 mod aa;
 mod agreement;
 mod conformance;
+mod effects;
 mod hard_cases;
 mod loaders;
 mod oracles;

@@ -1,0 +1,313 @@
+//! Shading of visible samples: Lambert with every light of the scene (or a
+//! headlight at the eye), base colour and emission from the material, normals
+//! interpolated from the vertices where the mesh has them, and the effects the
+//! scene calls for ([`plan`]): shadow rays, reflection rays ([`secondary`]).
+//! Shading reads only the triangle id, the sample's ray and its depth, so
+//! algorithms that agree on those produce identical colours. Colours are linear
+//! until the resolve ([`crate::aa`]) encodes the filtered pixel as sRGB.
+
+pub mod plan;
+pub mod secondary;
+
+use std::time::Instant;
+
+use glam::Vec3;
+
+use crate::prepared::PreparedScene;
+use crate::scene::LightKind;
+use plan::{EffectCounters, EffectPlan, REFLECTION_DEPTH};
+use secondary::Rays;
+
+/// Background colour (sRGB).
+pub const BACKGROUND_COLOR: [u8; 4] = [24, 24, 28, 255];
+
+/// Colour of pixels the viewport casts no ray through (outside the parabolic disc).
+pub const OUTSIDE_VIEWPORT_COLOR: [u8; 4] = [0, 0, 0, 255];
+
+/// Share of the base colour that is lit regardless of the light direction.
+const AMBIENT: f32 = 0.12;
+
+/// Secondary rays start this far (relative to the scene's radius) from the
+/// surface they leave, besides skipping its own triangle.
+const SECONDARY_OFFSET: f32 = 1e-5;
+
+/// Shades samples of one scene.
+#[derive(Clone, Debug)]
+pub struct Shader<'a> {
+    scene: &'a PreparedScene,
+    plan: EffectPlan,
+    /// Per light: its slot among the plan's shadow lights.
+    shadow_slot: Vec<Option<usize>>,
+    rays: Rays<'a>,
+    t_min: f32,
+}
+
+impl<'a> Shader<'a> {
+    pub fn new(scene: &'a PreparedScene) -> Shader<'a> {
+        let plan = EffectPlan::of(&scene.scene);
+        let shadow_slot = (0..scene.scene.lights.len())
+            .map(|l| plan.shadow_lights.iter().position(|&s| s == l))
+            .collect();
+        Shader {
+            scene,
+            plan,
+            shadow_slot,
+            rays: Rays::new(scene),
+            t_min: scene.bounds.radius().max(f32::MIN_POSITIVE) * SECONDARY_OFFSET,
+        }
+    }
+
+    /// What this shader runs besides local shading.
+    pub fn plan(&self) -> &EffectPlan {
+        &self.plan
+    }
+
+    /// Linear colour of triangle `id` seen along the ray `origin + t·dir` at
+    /// depth `depth` (the ray's own parameter: `w` on planar views, the distance
+    /// on non-planar ones); effect rays are counted into `effects`.
+    #[inline]
+    pub fn shade(
+        &self,
+        id: u32,
+        origin: Vec3,
+        dir: Vec3,
+        depth: f32,
+        effects: &mut EffectCounters,
+    ) -> Vec3 {
+        self.shade_surface(id, origin, dir, depth, 0, effects)
+    }
+
+    fn shade_surface(
+        &self,
+        id: u32,
+        origin: Vec3,
+        dir: Vec3,
+        depth: f32,
+        bounce: u32,
+        effects: &mut EffectCounters,
+    ) -> Vec3 {
+        let point = origin + dir * depth;
+        let view_dir = dir.normalize_or_zero();
+        let normal = self.shading_normal(id, origin, dir);
+        let scene = &self.scene.scene;
+
+        // 1. Direct light: Lambert per light, each shadow-casting light's term
+        // only where its shadow ray reaches it (primary surfaces only, Fig. 8).
+        let mut lit = Vec3::ZERO;
+        if scene.lights.is_empty() {
+            lit = Vec3::splat(normal.dot(-view_dir).max(0.0));
+        }
+        for (l, light) in scene.lights.iter().enumerate() {
+            let (to_light, distance) = match &light.kind {
+                LightKind::Directional { direction } => {
+                    (-direction.normalize_or_zero(), f32::INFINITY)
+                }
+                LightKind::Point { position } | LightKind::Spot { position, .. } => {
+                    let to = *position - point;
+                    (to.normalize_or_zero(), to.length())
+                }
+            };
+            let lambert = normal.dot(to_light);
+            if lambert <= 0.0 {
+                continue;
+            }
+            if bounce == 0
+                && let Some(slot) = self.shadow_slot[l]
+            {
+                let start = Instant::now();
+                effects.shadow_rays[slot] += 1;
+                let shadowed = self
+                    .rays
+                    .occluded(point, to_light, self.t_min, distance, id);
+                effects.shadow_s += start.elapsed().as_secs_f64();
+                if shadowed {
+                    continue;
+                }
+            }
+            lit += Vec3::from(light.color).min(Vec3::ONE) * lambert;
+        }
+        let material = &scene.materials[scene.mesh.material_ids[id as usize] as usize];
+        let base = Vec3::new(
+            material.base_color[0],
+            material.base_color[1],
+            material.base_color[2],
+        );
+        let local = base * (AMBIENT + (1.0 - AMBIENT) * lit) + Vec3::from(material.emissive);
+
+        // 2. A mirror's reflection ray, shaded where it lands.
+        let r = material.reflectivity.clamp(0.0, 1.0);
+        if r == 0.0 || bounce >= REFLECTION_DEPTH {
+            return local;
+        }
+        let start = Instant::now();
+        effects.reflection_rays += 1;
+        let mirrored = view_dir - 2.0 * view_dir.dot(normal) * normal;
+        let hit = self.rays.closest(point, mirrored, self.t_min, id);
+        effects.reflection_s += start.elapsed().as_secs_f64();
+        let reflected = match hit {
+            Some(h) => self.shade_surface(h.id, point, mirrored, h.t, bounce + 1, effects),
+            None => linear_rgb(BACKGROUND_COLOR),
+        };
+        local * (1.0 - r) + reflected * r
+    }
+
+    /// The unit normal that shades triangle `id` where the ray meets it, facing
+    /// the ray: interpolated from the vertex normals with the perspective-correct
+    /// barycentrics `λ_i = V_i / ΣV` (paper §3.2) when the mesh has them, the
+    /// face normal otherwise.
+    fn shading_normal(&self, id: u32, origin: Vec3, dir: Vec3) -> Vec3 {
+        let face = self.scene.face_normals[id as usize];
+        let toward = if face.dot(dir) > 0.0 { -1.0 } else { 1.0 };
+        let mesh = &self.scene.scene.mesh;
+        if mesh.normals.is_empty() {
+            return face * toward;
+        }
+        let [a, b, c] = mesh.triangles[id as usize];
+        let vertex = [a, b, c].map(|v| mesh.normals[v as usize]);
+        if vertex.contains(&Vec3::ZERO) {
+            return face * toward;
+        }
+        let lambda = secondary::barycentrics(&self.scene.triangles[id as usize], origin, dir);
+        let n = vertex[0] * lambda[0] + vertex[1] * lambda[1] + vertex[2] * lambda[2];
+        match n.try_normalize() {
+            Some(n) => n * toward,
+            None => face * toward,
+        }
+    }
+}
+
+/// Linear [0, 1] → sRGB byte: the transfer function, rounded to nearest.
+#[inline]
+fn encode_srgb_formula(v: f32) -> u8 {
+    let v = v.clamp(0.0, 1.0);
+    let s = if v <= 0.003_130_8 {
+        v * 12.92
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0 + 0.5) as u8
+}
+
+/// Buckets of the encoding table over [0, 1].
+const SRGB_BUCKETS: usize = 4096;
+
+/// [`encode_srgb_formula`] as tables: the first byte of each of
+/// [`SRGB_BUCKETS`] equal buckets, and per byte the smallest linear value
+/// that encodes to it (found by bisection over `f32` bit patterns, which
+/// order non-negative values).
+struct SrgbTable {
+    bucket_start: Vec<u8>,
+    thresholds: [f32; 256],
+}
+
+fn srgb_table() -> &'static SrgbTable {
+    static TABLE: std::sync::OnceLock<SrgbTable> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        let mut thresholds = [0.0f32; 256];
+        for (b, t) in thresholds.iter_mut().enumerate().skip(1) {
+            let (mut lo, mut hi) = (0u32, 1.0f32.to_bits());
+            while lo < hi {
+                let mid = lo + (hi - lo) / 2;
+                if usize::from(encode_srgb_formula(f32::from_bits(mid))) >= b {
+                    hi = mid;
+                } else {
+                    lo = mid + 1;
+                }
+            }
+            *t = f32::from_bits(lo);
+        }
+        let bucket_start = (0..=SRGB_BUCKETS)
+            .map(|i| encode_srgb_formula(i as f32 / SRGB_BUCKETS as f32))
+            .collect();
+        SrgbTable {
+            bucket_start,
+            thresholds,
+        }
+    })
+}
+
+/// Linear [0, 1] → sRGB byte, exactly the transfer function (tested on
+/// every threshold and millions of values) without its `powf`: the bucket's
+/// first byte, then up past the thresholds `v` reaches (at most a step or two).
+#[inline]
+pub fn encode_srgb(v: f32) -> u8 {
+    // NaN and v ≤ 0 encode to 0; v ≥ 1 to 255.
+    if v.is_nan() || v <= 0.0 {
+        return 0;
+    }
+    if v >= 1.0 {
+        return 255;
+    }
+    let table = srgb_table();
+    // Exact: scaling by a power of two does not round.
+    let mut b = table.bucket_start[(v * SRGB_BUCKETS as f32) as usize];
+    while b < 255 && v >= table.thresholds[usize::from(b) + 1] {
+        b += 1;
+    }
+    b
+}
+
+/// sRGB byte → linear [0, 1].
+#[inline]
+pub fn decode_srgb(b: u8) -> f32 {
+    let s = f32::from(b) / 255.0;
+    if s <= 0.040_45 {
+        s / 12.92
+    } else {
+        ((s + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// An sRGB colour in linear light.
+pub fn linear_rgb(c: [u8; 4]) -> Vec3 {
+    Vec3::new(decode_srgb(c[0]), decode_srgb(c[1]), decode_srgb(c[2]))
+}
+
+/// Linear RGB → opaque sRGB RGBA8.
+#[inline]
+pub fn encode_rgb(c: Vec3) -> [u8; 4] {
+    [encode_srgb(c.x), encode_srgb(c.y), encode_srgb(c.z), 255]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_encoding_tables_give_exactly_the_transfer_function() {
+        let table = srgb_table();
+        let mut values: Vec<f32> = vec![
+            0.0,
+            -0.0,
+            -1.0,
+            1.0,
+            2.0,
+            f32::NAN,
+            f32::INFINITY,
+            0.003_130_8,
+        ];
+        for &t in &table.thresholds {
+            for d in -3i32..=3 {
+                values.push(f32::from_bits(t.to_bits().saturating_add_signed(d)));
+            }
+        }
+        let mut rng = fastrand::Rng::with_seed(5);
+        values.extend((0..2_000_000).map(|_| rng.f32()));
+        values.extend((0..200_000).map(|_| rng.f32() * 0.01));
+        for v in values {
+            assert_eq!(
+                encode_srgb(v),
+                encode_srgb_formula(v),
+                "{v} ({:#x})",
+                v.to_bits()
+            );
+        }
+    }
+
+    #[test]
+    fn every_srgb_byte_survives_decoding_and_encoding() {
+        for b in 0..=255u8 {
+            assert_eq!(encode_srgb(decode_srgb(b)), b);
+        }
+    }
+}

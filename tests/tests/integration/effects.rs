@@ -1,0 +1,179 @@
+//! Effects run only when the scene calls for them, each counted; secondary rays
+//! are watertight; and every algorithm shades the same image with effects on.
+
+use continuum::scene::Scene;
+use continuum::shade::secondary::{Rays, intersect};
+use continuum::{AlgorithmId, Family, PreparedScene};
+use continuum_tests::{builtin_scenes, prepared, render_with};
+use glam::Vec3;
+
+const SIZE: (u32, u32) = (160, 120);
+
+/// (effect, light) → rays, from a render's stats.
+fn rays(scene: &PreparedScene, algorithm: AlgorithmId) -> Vec<(String, Option<String>, u64)> {
+    let camera = scene.scene.first_camera();
+    let out = render_with(scene, algorithm, &camera, SIZE.0, SIZE.1);
+    out.stats
+        .effects
+        .iter()
+        .map(|e| (e.effect.to_owned(), e.light.clone(), e.rays))
+        .collect()
+}
+
+#[test]
+fn a_scene_pays_only_for_the_effects_it_calls_for() {
+    for name in builtin_scenes() {
+        let scene = prepared(&name);
+        let wants = scene.scene.effects();
+        let report = rays(&scene, AlgorithmId::ThreeDBrute);
+        let ran = |effect: &str| report.iter().any(|(e, _, _)| e == effect);
+        for effect in ["shadows", "reflections"] {
+            assert_eq!(
+                ran(effect),
+                wants.contains(&effect),
+                "{name}: {effect} ran = {}, {report:?}",
+                ran(effect)
+            );
+        }
+        // Whatever ran cast rays (every effect scene shows its effect from its first camera).
+        assert!(report.iter().all(|(_, _, n)| *n > 0), "{name}: {report:?}");
+    }
+    assert!(
+        prepared("bunny").scene.effects().is_empty(),
+        "bunny calls for no effect"
+    );
+}
+
+#[test]
+fn turning_one_lights_shadows_off_removes_exactly_its_rays() {
+    let both = prepared("shadows");
+    let before = rays(&both, AlgorithmId::ThreeDBrute);
+    let lamp = before
+        .iter()
+        .find(|(_, l, _)| l.as_deref() == Some("lamp"))
+        .expect("the lamp casts shadows")
+        .2;
+    let mut scene: Scene = (*both.scene).clone();
+    let l = scene
+        .lights
+        .iter()
+        .position(|l| l.name == "lamp")
+        .expect("a lamp");
+    scene.lights[l].shadows = false;
+    let after = rays(&PreparedScene::new(scene), AlgorithmId::ThreeDBrute);
+    let others: Vec<_> = before
+        .iter()
+        .filter(|(_, l, _)| l.as_deref() != Some("lamp"))
+        .cloned()
+        .collect();
+    assert_eq!(
+        after, others,
+        "the sun's rays are unchanged and the lamp's are gone"
+    );
+    let total = |r: &[(String, Option<String>, u64)]| r.iter().map(|x| x.2).sum::<u64>();
+    assert_eq!(total(&before) - total(&after), lamp);
+}
+
+#[test]
+fn every_algorithm_shades_the_same_image_with_effects() {
+    for name in ["shadows", "mirror", "fig8"] {
+        let scene = prepared(name);
+        for camera in scene.scene.all_cameras() {
+            let reference = render_with(&scene, AlgorithmId::ThreeDBrute, &camera, SIZE.0, SIZE.1);
+            assert!(!reference.stats.effects.is_empty(), "{name}");
+            for algorithm in AlgorithmId::CPU
+                .into_iter()
+                .filter(|a| a.family() == Family::ThreeD)
+            {
+                let out = render_with(&scene, algorithm, &camera, SIZE.0, SIZE.1);
+                assert_eq!(
+                    out.hashes.triangle_id, reference.hashes.triangle_id,
+                    "{name}/{} {algorithm}",
+                    camera.name
+                );
+                assert_eq!(
+                    out.hashes.color, reference.hashes.color,
+                    "{name}/{} {algorithm}",
+                    camera.name
+                );
+                let counts = |o: &continuum::RenderOutput| {
+                    o.stats.effects.iter().map(|e| e.rays).collect::<Vec<_>>()
+                };
+                assert_eq!(
+                    counts(&out),
+                    counts(&reference),
+                    "{name}/{} {algorithm}",
+                    camera.name
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn fig8_casts_one_shadow_and_one_reflection_ray_per_lit_sample() {
+    let scene = prepared("fig8");
+    let camera = scene.scene.first_camera();
+    let out = render_with(&scene, AlgorithmId::ThreeDFull, &camera, SIZE.0, SIZE.1);
+    let covered = out
+        .framebuffer
+        .triangle_id
+        .iter()
+        .filter(|&&id| id != continuum::BACKGROUND)
+        .count() as u64;
+    let get = |effect: &str| {
+        out.stats
+            .effects
+            .iter()
+            .find(|e| e.effect == effect)
+            .map_or(0, |e| e.rays)
+    };
+    // Every material reflects: one reflection ray per visible sample; one
+    // shadow ray per visible sample that faces the sun.
+    assert_eq!(get("reflections"), covered);
+    assert!(
+        get("shadows") <= covered && get("shadows") > covered / 2,
+        "{} of {covered}",
+        get("shadows")
+    );
+}
+
+#[test]
+fn secondary_rays_from_inside_a_closed_mesh_hit_it_exactly_once() {
+    let sphere = prepared("sphere");
+    let mut rng = fastrand::Rng::with_seed(8);
+    let rays = Rays::new(&sphere);
+    for _ in 0..2000 {
+        let origin = Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5) * 0.8;
+        let dir = Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5);
+        let hits = sphere
+            .drawable
+            .iter()
+            .filter(|&&id| {
+                intersect(
+                    &sphere.triangles[id as usize],
+                    origin,
+                    dir,
+                    0.0,
+                    f32::INFINITY,
+                )
+                .is_some()
+            })
+            .count();
+        assert_eq!(hits, 1, "from {origin} along {dir}");
+        // The BVH walk finds that one hit, and the shadow query agrees.
+        let hit = rays.closest(origin, dir, 0.0, u32::MAX).expect("a hit");
+        assert!(
+            intersect(
+                &sphere.triangles[hit.id as usize],
+                origin,
+                dir,
+                0.0,
+                f32::INFINITY
+            )
+            .is_some()
+        );
+        assert!(rays.occluded(origin, dir, 0.0, f32::INFINITY, u32::MAX));
+        assert!(!rays.occluded(origin, dir, 0.0, hit.t * 0.999, u32::MAX));
+    }
+}
