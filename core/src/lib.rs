@@ -10,7 +10,7 @@
 //! let scene = continuum::scene::load_path("scenes/bunny.toml".as_ref()).unwrap();
 //! let prepared = PreparedScene::new(scene);
 //! let camera = prepared.scene.first_camera();
-//! let out = render(&prepared, &RenderRequest { algorithm: AlgorithmId::ThreeDBrute, oracles: None, camera, width: 640, height: 480, aa: Default::default(), precision: Default::default() }).unwrap();
+//! let out = render(&prepared, &RenderRequest { algorithm: AlgorithmId::ThreeDBrute, oracles: None, camera, width: 640, height: 480, aa: Default::default(), precision: Default::default(), texture_filter: Default::default() }).unwrap();
 //! println!("{}", out.hashes.triangle_id);
 //! ```
 

@@ -9,6 +9,7 @@ use rayon::prelude::*;
 
 use crate::bvh::SceneBvh;
 use crate::scene::{Bounds, Scene};
+use crate::shade::texture::MipChain;
 
 /// A scene ready to render from any camera.
 #[derive(Debug)]
@@ -28,6 +29,9 @@ pub struct PreparedScene {
     pub bounds: Bounds,
     /// Near distance for cameras that give none: 1e-3 of the bounding radius.
     pub default_near: f32,
+    /// Decoded textures with their mip chains, one per `scene.images` entry
+    /// (or why it could not be decoded); empty when no material is textured.
+    pub textures: Vec<Result<MipChain, String>>,
     /// The drawable triangles on the GPU, uploaded by the first `gpu-raster` render.
     #[cfg(feature = "gpu")]
     pub(crate) gpu_mesh: std::sync::OnceLock<Result<crate::gpu::GpuMesh, crate::gpu::GpuError>>,
@@ -68,7 +72,22 @@ impl PreparedScene {
         } else {
             bounds.radius().max(1e-6)
         };
+        // Textures only when a material uses one (the effect plan's rule).
+        let textured = scene
+            .materials
+            .iter()
+            .any(|m| m.base_color_texture.is_some());
+        let textures = if textured {
+            scene
+                .images
+                .par_iter()
+                .map(|i| MipChain::load(&i.source))
+                .collect()
+        } else {
+            Vec::new()
+        };
         PreparedScene {
+            textures,
             triangles,
             face_normals,
             drawable,
@@ -95,6 +114,12 @@ impl PreparedScene {
             + self.slot_triangles.len() * 4
             + self.bvh.cwbvh.nodes.len() * (80 + 192)
             + self.bvh.cwbvh.primitive_indices.len() * 4
+            + self
+                .textures
+                .iter()
+                .flatten()
+                .map(|t| t.texel_count() * 16)
+                .sum::<usize>()
     }
 
     /// Triangle count, degenerate ones included.

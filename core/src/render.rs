@@ -12,6 +12,8 @@ use crate::framebuffer::Framebuffer;
 use crate::precision::Precision;
 use crate::prepared::PreparedScene;
 use crate::request::FieldError;
+use crate::shade::Shader;
+use crate::shade::texture::TextureFilter;
 use crate::stats::{Hashes, Stats};
 
 /// Largest width or height a render accepts.
@@ -31,6 +33,8 @@ pub struct RenderRequest {
     pub aa: AaMode,
     /// The number representation coverage is decided in.
     pub precision: Precision,
+    /// How texture lookups are filtered (when the scene has textures).
+    pub texture_filter: TextureFilter,
 }
 
 /// A request that cannot be rendered, with the field at fault.
@@ -162,15 +166,20 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
         )
         .into());
     }
+    let shader = Shader::new(scene, &view, request.texture_filter);
     if pipeline == Pipeline::Gpu {
-        render_on_gpu(scene, request, &view, &mut fb, &mut stats)?;
+        render_on_gpu(scene, request, &view, &shader, &mut fb, &mut stats)?;
     } else {
+        let context = algorithm::TileContext {
+            view: &view,
+            pattern: &pattern,
+            shader,
+        };
         algorithm::run(
             pipeline,
             request.precision,
             scene,
-            &view,
-            &pattern,
+            &context,
             &mut fb,
             &mut stats,
         );
@@ -205,6 +214,7 @@ fn render_on_gpu(
     scene: &PreparedScene,
     request: &RenderRequest,
     view: &View,
+    shader: &Shader,
     fb: &mut Framebuffer,
     stats: &mut Stats,
 ) -> Result<(), RenderError> {
@@ -219,7 +229,7 @@ fn render_on_gpu(
         )
         .into());
     }
-    crate::gpu::render_gpu_raster(scene, view, fb, stats).map_err(|e| RenderError {
+    crate::gpu::render_gpu_raster(scene, view, shader, fb, stats).map_err(|e| RenderError {
         field: match e {
             GpuError::TooLarge { .. } => "size",
             GpuError::SceneTooLarge { .. } => "scene",
@@ -234,6 +244,7 @@ fn render_on_gpu(
     _: &PreparedScene,
     _: &RenderRequest,
     _: &View,
+    _: &Shader,
     _: &mut Framebuffer,
     _: &mut Stats,
 ) -> Result<(), RenderError> {

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use continuum::request::{parse_aa, parse_algorithm, parse_size, parse_viewport};
+use continuum::shade::texture::TextureFilter;
 use continuum::{AlgorithmId, Precision, PreparedScene, RenderRequest, maps, render};
 
 use crate::{CliError, scenes_dir, write_stdout};
@@ -36,6 +37,10 @@ pub struct RenderArgs {
     /// family: vertices snapped to 1/256 pixel, exact integer edge functions).
     #[arg(long, default_value = "f32", value_parser = |s: &str| Precision::parse(s).map_err(|e| e.message))]
     precision: Precision,
+    /// Texture filtering (scenes with textures): nearest, bilinear, trilinear
+    /// or anisotropic:N (N in 1..=16).
+    #[arg(long, default_value = "trilinear", value_parser = |s: &str| TextureFilter::parse(s).map_err(|e| e.message))]
+    texture_filter: TextureFilter,
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "640x480", value_parser = |s: &str| parse_size(s).map_err(|e| e.message))]
     size: (u32, u32),
@@ -81,6 +86,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         height,
         aa,
         precision: args.precision,
+        texture_filter: args.texture_filter,
     };
     let out = render(&prepared, &request).map_err(|e| CliError::Usage(format!("--{e}")))?;
 

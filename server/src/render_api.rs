@@ -11,6 +11,7 @@ use base64::Engine;
 use continuum::request::{
     CameraSpec, FieldError, parse_aa, parse_algorithm, parse_size, parse_viewport,
 };
+use continuum::shade::texture::TextureFilter;
 use continuum::{AaMode, AlgorithmId, Precision, RenderOutput, RenderRequest, Viewport, maps};
 use serde::Deserialize;
 use serde_json::{Value, json};
@@ -29,6 +30,7 @@ pub struct RenderBody {
     pub viewport: Option<String>,
     pub aa: Option<String>,
     pub precision: Option<String>,
+    pub texture_filter: Option<String>,
     pub size: Option<String>,
     pub outputs: Option<Vec<String>>,
 }
@@ -46,6 +48,7 @@ struct Checked {
     size: (u32, u32),
     aa: AaMode,
     precision: Precision,
+    texture_filter: TextureFilter,
 }
 
 fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
@@ -134,6 +137,12 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
     if !precision.serves(algorithm.family()) {
         return Err(precision.unsupported(algorithm).into());
     }
+    let texture_filter = body
+        .texture_filter
+        .as_deref()
+        .map(TextureFilter::parse)
+        .transpose()?
+        .unwrap_or_default();
     Ok(Checked {
         scene: body.scene.clone(),
         algorithm,
@@ -143,6 +152,7 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
         size,
         aa,
         precision,
+        texture_filter,
     })
 }
 
@@ -176,6 +186,7 @@ async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, 
             height: c.size.1,
             aa: c.aa,
             precision: c.precision,
+            texture_filter: c.texture_filter,
         };
         let out = continuum::render(&prepared, &request)
             .map_err(|e| ApiError::bad_request(e.field, e.to_string()))?;
@@ -244,6 +255,7 @@ pub struct RenderQuery {
     viewport: Option<String>,
     aa: Option<String>,
     precision: Option<String>,
+    texture_filter: Option<String>,
     size: Option<String>,
     output: Option<String>,
 }
@@ -269,6 +281,7 @@ pub async fn render_png(
         viewport: q.viewport,
         aa: q.aa,
         precision: q.precision,
+        texture_filter: q.texture_filter,
         size: q.size,
         outputs: Some(vec![output.clone()]),
     };

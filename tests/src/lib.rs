@@ -66,6 +66,7 @@ pub fn render_with_oracles(
             height,
             aa: continuum::AaMode::None,
             precision: Default::default(),
+            texture_filter: Default::default(),
         },
     )
     .unwrap_or_else(|e| panic!("{algorithm} {oracles:?}: {e}"))
@@ -119,6 +120,7 @@ pub fn render_full(
             height,
             aa,
             precision,
+            texture_filter: Default::default(),
         },
     )
     .unwrap_or_else(|e| panic!("{algorithm} {aa} {precision}: {e}"))

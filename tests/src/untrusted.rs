@@ -49,6 +49,7 @@ pub fn exercise(format: Format, data: &[u8]) -> Result<(), String> {
             height: 16,
             aa: AaMode::None,
             precision: Default::default(),
+            texture_filter: Default::default(),
         };
         // A camera the scene names may not serve every algorithm (a
         // non-planar viewport with a 2D one): an error, not a crash.

@@ -7,6 +7,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, PoisonError};
 
+use continuum::shade::texture::TextureFilter;
 use continuum::{AaMode, AlgorithmId, Precision, RenderOutput, Stats, Viewport};
 use eframe::egui::{self, Color32, ColorImage, TextureHandle, TextureOptions};
 
@@ -163,11 +164,7 @@ impl ViewerApp {
             config: self.config.clone(),
             compare: self.compare.clone(),
         };
-        let changed = self
-            .submitted
-            .as_ref()
-            .is_none_or(|s| s.config != job.config || s.compare != job.compare);
-        if changed {
+        if self.submitted.as_ref() != Some(&job) {
             self.worker.submit(job.clone());
             self.submitted = Some(job);
         }
@@ -716,6 +713,23 @@ fn method_controls(ui: &mut egui::Ui, id: &str, method: &mut Method) {
                 .show_ui(ui, |ui| {
                     for p in Precision::ALL {
                         ui.selectable_value(&mut method.precision, p, p.as_str());
+                    }
+                })
+                .response
+                .labelled_by(label.id);
+            ui.end_row();
+            let label = ui.label("textures");
+            egui::ComboBox::from_id_salt(("texture filter", id))
+                .selected_text(method.texture_filter.to_string())
+                .show_ui(ui, |ui| {
+                    for f in [
+                        TextureFilter::Nearest,
+                        TextureFilter::Bilinear,
+                        TextureFilter::Trilinear,
+                        TextureFilter::Anisotropic(4),
+                        TextureFilter::Anisotropic(16),
+                    ] {
+                        ui.selectable_value(&mut method.texture_filter, f, f.to_string());
                     }
                 })
                 .response

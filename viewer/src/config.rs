@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use continuum::request::{parse_aa, parse_algorithm, parse_size, parse_viewport};
+use continuum::shade::texture::TextureFilter;
 use continuum::{AaMode, AlgorithmId, Camera, Precision, RenderRequest, Scene};
 
 /// Whether `path` names a scene file or a model the loaders read.
@@ -74,6 +75,8 @@ pub struct Method {
     pub oracles: String,
     pub aa: AaMode,
     pub precision: Precision,
+    /// Texture filtering (for scenes with textures).
+    pub texture_filter: TextureFilter,
 }
 
 impl Default for Method {
@@ -83,6 +86,7 @@ impl Default for Method {
             oracles: String::new(),
             aa: AaMode::None,
             precision: Precision::F32,
+            texture_filter: TextureFilter::default(),
         }
     }
 }
@@ -153,6 +157,7 @@ impl Config {
                 oracles: String::new(),
                 aa: parse_aa(aa)?,
                 precision: Precision::parse(precision)?,
+                texture_filter: TextureFilter::default(),
             },
             width,
             height,
@@ -187,6 +192,7 @@ impl Config {
             height: self.height,
             aa: method.aa,
             precision: method.precision,
+            texture_filter: method.texture_filter,
         })
     }
 }

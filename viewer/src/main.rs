@@ -40,6 +40,9 @@ struct Args {
     /// Precision of coverage decisions: f32, f64 or fixed.
     #[arg(long, default_value = "f32")]
     precision: String,
+    /// Texture filtering: nearest, bilinear, trilinear or anisotropic:N.
+    #[arg(long, default_value = "trilinear")]
+    texture_filter: String,
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "640x480")]
     size: String,
@@ -79,6 +82,10 @@ fn main() -> ExitCode {
         Err(e) => return usage(format!("--{e}")),
     };
     config.method.oracles = args.oracles.clone().unwrap_or_default();
+    match continuum::shade::texture::TextureFilter::parse(&args.texture_filter) {
+        Ok(f) => config.method.texture_filter = f,
+        Err(e) => return usage(format!("--{e}")),
+    }
     if let Some(t) = args.threads {
         if t == 0 {
             return usage("--threads: must be at least 1".into());

@@ -16,7 +16,7 @@ use crate::config::{Config, ConfigError, Method, SceneSource};
 
 /// What the UI asks for: a configuration, and optionally a second method to
 /// render beside it (the compare view's B).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Job {
     pub config: Config,
     pub compare: Option<Method>,

@@ -76,6 +76,7 @@ fn reference() -> image::RgbaImage {
         height: SIZE.1,
         aa: Default::default(),
         precision: Default::default(),
+        texture_filter: Default::default(),
     };
     maps::color_image(&render(&prepared, &request).expect("renders").framebuffer)
 }

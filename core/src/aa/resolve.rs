@@ -122,7 +122,8 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
                     Some(_) if id == BACKGROUND => background,
                     Some((origin, dir)) => {
                         out.shading_samples += 1;
-                        shader.shade(id, origin, dir, depth_at(s), &mut out.effects)
+                        let at = (x as f32 + ox, y as f32 + oy);
+                        shader.shade(id, at, (origin, dir), depth_at(s), &mut out.effects)
                     }
                 };
             }

@@ -342,16 +342,11 @@ pub(crate) fn run(
     pipeline: Pipeline,
     precision: Precision,
     scene: &PreparedScene,
-    view: &View,
-    pattern: &SamplePattern,
+    context: &TileContext,
     fb: &mut Framebuffer,
     stats: &mut Stats,
 ) {
-    let context = TileContext {
-        view,
-        pattern,
-        shader: Shader::new(scene),
-    };
+    let (view, pattern) = (context.view, context.pattern);
     let f64 = precision == Precision::F64;
     let pass = match pipeline {
         Pipeline::AllTriangles { edges, samples } => {
@@ -360,7 +355,7 @@ pub(crate) fn run(
             // One generic call per edge kind (a closure cannot be generic).
             macro_rules! tiles {
                 ($items:expr) => {
-                    timed_tiles(&$items, fb, samples, &context, stats, start)
+                    timed_tiles(&$items, fb, samples, context, stats, start)
                 };
             }
             match edges {
@@ -388,18 +383,18 @@ pub(crate) fn run(
             }
         }
         Pipeline::Frusta(oracles) if f64 => {
-            render_frusta(scene, &context, oracles, fb, stats, Triangle3D64::setup)
+            render_frusta(scene, context, oracles, fb, stats, Triangle3D64::setup)
         }
         Pipeline::Frusta(oracles) => {
-            render_frusta(scene, &context, oracles, fb, stats, Triangle3D::setup)
+            render_frusta(scene, context, oracles, fb, stats, Triangle3D::setup)
         }
         Pipeline::Rays if view.sphere.is_some() => {
-            raycast::render_raycast(scene, &context, fb, stats, CurvedTriangle::setup)
+            raycast::render_raycast(scene, context, fb, stats, CurvedTriangle::setup)
         }
         Pipeline::Rays if f64 => {
-            raycast::render_raycast(scene, &context, fb, stats, Triangle3D64::setup)
+            raycast::render_raycast(scene, context, fb, stats, Triangle3D64::setup)
         }
-        Pipeline::Rays => raycast::render_raycast(scene, &context, fb, stats, Triangle3D::setup),
+        Pipeline::Rays => raycast::render_raycast(scene, context, fb, stats, Triangle3D::setup),
         Pipeline::Gpu => unreachable!("gpu-raster renders through crate::gpu"),
     };
     stats.counters = pass.counters;

@@ -455,6 +455,7 @@ fn camera_uniform(view: &View, far: f32) -> CameraUniform {
 pub(crate) fn render_gpu_raster(
     scene: &PreparedScene,
     view: &View,
+    shader: &Shader,
     fb: &mut Framebuffer,
     stats: &mut Stats,
 ) -> Result<(), GpuError> {
@@ -480,8 +481,7 @@ pub(crate) fn render_gpu_raster(
     tile.triangle_id = samples.triangle_id;
     tile.depth = samples.depth;
     tile.coverage_writes = samples.fragments.into_iter().map(u32::from).collect();
-    let shader = Shader::new(scene);
-    let resolved = resolve_tile(&tile, view, &shader);
+    let resolved = resolve_tile(&tile, view, shader);
     stats.effects = resolved.effects.report(shader.plan(), &scene.scene);
     stats.coverage_histogram = resolved.histogram;
     stats.shading_samples = resolved.shading_samples;

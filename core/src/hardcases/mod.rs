@@ -408,6 +408,7 @@ pub fn check_view(
             height,
             aa: AaMode::None,
             precision,
+            texture_filter: Default::default(),
         };
         let out = match catch_unwind(AssertUnwindSafe(|| render(scene, &request))) {
             Ok(Ok(out)) => {

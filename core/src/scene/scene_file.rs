@@ -37,6 +37,7 @@
 //! emissive = [0, 0, 0]
 //! opacity = 1.0
 //! reflectivity = 0.0
+//! base_color_texture = "assets/checker.png"   # optional: PNG or JPEG, sRGB, on the mesh's uvs
 //! ```
 //! Unknown keys are errors that name the key.
 
@@ -47,7 +48,8 @@ use serde::Deserialize;
 
 use super::procedural::Generator;
 use super::{
-    Light, LightKind, Material, Mesh, PartLocation, Scene, SceneError, load_path, validate_part,
+    ImageRef, ImageSource, Light, LightKind, Material, Mesh, PartLocation, Scene, SceneError,
+    TextureRef, load_path, validate_part,
 };
 use crate::camera::{Camera, Viewport};
 
@@ -142,6 +144,9 @@ pub struct MaterialEntry {
     pub emissive: Option<[f32; 3]>,
     pub opacity: Option<f32>,
     pub reflectivity: Option<f32>,
+    /// A PNG or JPEG file (relative to the scene file) as the base-colour
+    /// texture, on the mesh's first texture coordinates.
+    pub base_color_texture: Option<String>,
 }
 
 impl SceneFile {
@@ -300,6 +305,24 @@ fn build(doc: &SceneFile, file: &str, name: String, dir: &Path) -> Result<Scene,
                 )));
             }
             target.reflectivity = r;
+        }
+        if let Some(file) = &m.base_color_texture {
+            let path = dir.join(file);
+            if !path.is_file() {
+                return Err(err(format!(
+                    "material '{}': base_color_texture '{}' is not a file",
+                    m.name,
+                    path.display()
+                )));
+            }
+            scene.images.push(ImageRef {
+                name: Some(file.clone()),
+                source: ImageSource::File(path),
+            });
+            scene.materials[index].base_color_texture = Some(TextureRef {
+                image: scene.images.len() - 1,
+                tex_coord: 0,
+            });
         }
     }
     for (entry, range) in doc.mesh.iter().zip(mesh_ranges) {

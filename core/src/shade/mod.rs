@@ -8,15 +8,20 @@
 
 pub mod plan;
 pub mod secondary;
+pub mod texture;
 
 use std::time::Instant;
 
 use glam::Vec3;
 
+use glam::Vec2;
+
+use crate::camera::View;
 use crate::prepared::PreparedScene;
 use crate::scene::LightKind;
 use plan::{EffectCounters, EffectPlan, REFLECTION_DEPTH};
-use secondary::Rays;
+use secondary::{Rays, barycentrics};
+use texture::TextureFilter;
 
 /// Background colour (sRGB).
 pub const BACKGROUND_COLOR: [u8; 4] = [24, 24, 28, 255];
@@ -35,6 +40,8 @@ const SECONDARY_OFFSET: f32 = 1e-5;
 #[derive(Clone, Debug)]
 pub struct Shader<'a> {
     scene: &'a PreparedScene,
+    view: &'a View,
+    filter: TextureFilter,
     plan: EffectPlan,
     /// Per light: its slot among the plan's shadow lights.
     shadow_slot: Vec<Option<usize>>,
@@ -43,13 +50,15 @@ pub struct Shader<'a> {
 }
 
 impl<'a> Shader<'a> {
-    pub fn new(scene: &'a PreparedScene) -> Shader<'a> {
+    pub fn new(scene: &'a PreparedScene, view: &'a View, filter: TextureFilter) -> Shader<'a> {
         let plan = EffectPlan::of(&scene.scene);
         let shadow_slot = (0..scene.scene.lights.len())
             .map(|l| plan.shadow_lights.iter().position(|&s| s == l))
             .collect();
         Shader {
             scene,
+            view,
+            filter,
             plan,
             shadow_slot,
             rays: Rays::new(scene),
@@ -64,22 +73,28 @@ impl<'a> Shader<'a> {
 
     /// Linear colour of triangle `id` seen along the ray `origin + t·dir` at
     /// depth `depth` (the ray's own parameter: `w` on planar views, the distance
-    /// on non-planar ones); effect rays are counted into `effects`.
+    /// on non-planar ones) from the sample at pixel position `at`; effect rays
+    /// and texture lookups are counted into `effects`.
     #[inline]
     pub fn shade(
         &self,
         id: u32,
-        origin: Vec3,
-        dir: Vec3,
+        at: (f32, f32),
+        (origin, dir): (Vec3, Vec3),
         depth: f32,
         effects: &mut EffectCounters,
     ) -> Vec3 {
-        self.shade_surface(id, origin, dir, depth, 0, effects)
+        self.shade_surface(id, Some(at), origin, dir, depth, 0, effects)
     }
 
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "one recursion step: the sample, its ray, the bounce and the counters"
+    )]
     fn shade_surface(
         &self,
         id: u32,
+        at: Option<(f32, f32)>,
         origin: Vec3,
         dir: Vec3,
         depth: f32,
@@ -127,11 +142,22 @@ impl<'a> Shader<'a> {
             lit += Vec3::from(light.color).min(Vec3::ONE) * lambert;
         }
         let material = &scene.materials[scene.mesh.material_ids[id as usize] as usize];
-        let base = Vec3::new(
+        let mut base = Vec3::new(
             material.base_color[0],
             material.base_color[1],
             material.base_color[2],
         );
+        if let Some(texture) = &material.base_color_texture
+            && let Some(Ok(chain)) = self.scene.textures.get(texture.image)
+            && !scene.mesh.uvs.is_empty()
+        {
+            let start = Instant::now();
+            let (color, probes) = self.texture_lookup(chain, id, at, origin, dir);
+            effects.texture_lookups += 1;
+            effects.texture_probes += u64::from(probes);
+            effects.texture_s += start.elapsed().as_secs_f64();
+            base *= color.truncate();
+        }
         let local = base * (AMBIENT + (1.0 - AMBIENT) * lit) + Vec3::from(material.emissive);
 
         // 2. A mirror's reflection ray, shaded where it lands.
@@ -145,10 +171,48 @@ impl<'a> Shader<'a> {
         let hit = self.rays.closest(point, mirrored, self.t_min, id);
         effects.reflection_s += start.elapsed().as_secs_f64();
         let reflected = match hit {
-            Some(h) => self.shade_surface(h.id, point, mirrored, h.t, bounce + 1, effects),
+            Some(h) => self.shade_surface(h.id, None, point, mirrored, h.t, bounce + 1, effects),
             None => linear_rgb(BACKGROUND_COLOR),
         };
         local * (1.0 - r) + reflected * r
+    }
+
+    /// Triangle `id`'s texture at the sample. Its coordinates are interpolated
+    /// with the §3.2 barycentrics; their derivatives come from the sample's 2×2
+    /// pixel quad — the rays through the quad's first pixel and its right and
+    /// lower neighbours, all met with this triangle's plane (`ddx_coarse`, the
+    /// same in every algorithm, `raycast` included). A reflected surface (`at`
+    /// = `None`) has no quad: the full-resolution level, bilinear.
+    fn texture_lookup(
+        &self,
+        chain: &texture::MipChain,
+        id: u32,
+        at: Option<(f32, f32)>,
+        origin: Vec3,
+        dir: Vec3,
+    ) -> (glam::Vec4, u32) {
+        let mesh = &self.scene.scene.mesh;
+        let corners = &self.scene.triangles[id as usize];
+        let [a, b, c] = mesh.triangles[id as usize];
+        let uv_along = |o: Vec3, d: Vec3| {
+            let l = barycentrics(corners, o, d);
+            mesh.uvs[a as usize] * l[0] + mesh.uvs[b as usize] * l[1] + mesh.uvs[c as usize] * l[2]
+        };
+        let uv = uv_along(origin, dir);
+        let Some((x, y)) = at else {
+            return chain.sample(uv, Vec2::ZERO, Vec2::ZERO, TextureFilter::Bilinear);
+        };
+        let qx = (x.floor() as i64 & !1) as f32 + 0.5;
+        let qy = (y.floor() as i64 & !1) as f32 + 0.5;
+        let uv_at = |px: f32, py: f32| self.view.ray(px, py).map(|(o, d)| uv_along(o, d));
+        let (ddx, ddy) = match (uv_at(qx, qy), uv_at(qx + 1.0, qy), uv_at(qx, qy + 1.0)) {
+            (Some(q), right, down) => (
+                right.map_or(Vec2::ZERO, |r| r - q),
+                down.map_or(Vec2::ZERO, |d| d - q),
+            ),
+            _ => (Vec2::ZERO, Vec2::ZERO),
+        };
+        chain.sample(uv, ddx, ddy, self.filter)
     }
 
     /// The unit normal that shades triangle `id` where the ray meets it, facing

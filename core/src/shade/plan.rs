@@ -19,6 +19,8 @@ pub struct EffectPlan {
     pub shadow_lights: Vec<usize>,
     /// Whether any material reflects.
     pub reflections: bool,
+    /// Whether any material has a base-colour texture.
+    pub textures: bool,
 }
 
 impl EffectPlan {
@@ -32,11 +34,15 @@ impl EffectPlan {
                 .map(|(i, _)| i)
                 .collect(),
             reflections: scene.materials.iter().any(|m| m.reflectivity > 0.0),
+            textures: scene
+                .materials
+                .iter()
+                .any(|m| m.base_color_texture.is_some()),
         }
     }
 
     pub fn is_empty(&self) -> bool {
-        self.shadow_lights.is_empty() && !self.reflections
+        self.shadow_lights.is_empty() && !self.reflections && !self.textures
     }
 }
 
@@ -44,6 +50,11 @@ impl EffectPlan {
 /// order), reflection rays, and the worker time each took.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct EffectCounters {
+    /// Texture lookups (one per textured shading), the bilinear probes they
+    /// took, and their time.
+    pub texture_lookups: u64,
+    pub texture_probes: u64,
+    pub texture_s: f64,
     pub shadow_rays: Vec<u64>,
     pub shadow_s: f64,
     pub reflection_rays: u64,
@@ -66,14 +77,28 @@ impl EffectCounters {
             *a += b;
         }
         self.shadow_s += o.shadow_s;
+        self.texture_lookups += o.texture_lookups;
+        self.texture_probes += o.texture_probes;
+        self.texture_s += o.texture_s;
         self.reflection_rays += o.reflection_rays;
         self.reflection_s += o.reflection_s;
     }
 
-    /// The `Stats.effects` entries: one per shadow-casting light, one for
-    /// reflections, in plan order.
+    /// The `Stats.effects` entries: textures, one per shadow-casting light,
+    /// reflections, in that order.
     pub fn report(&self, plan: &EffectPlan, scene: &Scene) -> Vec<EffectStats> {
-        let mut out: Vec<EffectStats> = plan
+        let mut out: Vec<EffectStats> = Vec::new();
+        if plan.textures {
+            out.push(EffectStats {
+                effect: "textures",
+                light: None,
+                rays: 0,
+                lookups: self.texture_lookups,
+                texel_probes: self.texture_probes,
+                worker_ms: self.texture_s * 1e3,
+            });
+        }
+        let shadows: Vec<EffectStats> = plan
             .shadow_lights
             .iter()
             .zip(&self.shadow_rays)
@@ -81,12 +106,15 @@ impl EffectCounters {
                 effect: "shadows",
                 light: Some(scene.lights[light].name.clone()),
                 rays,
+                lookups: 0,
+                texel_probes: 0,
                 worker_ms: 0.0,
             })
             .collect();
+        out.extend(shadows);
         // The shadow time is measured for all lights together; share it by rays.
         let total_shadow: u64 = self.shadow_rays.iter().sum();
-        for e in &mut out {
+        for e in out.iter_mut().filter(|e| e.effect == "shadows") {
             if total_shadow > 0 {
                 e.worker_ms = self.shadow_s * 1e3 * e.rays as f64 / total_shadow as f64;
             }
@@ -96,6 +124,8 @@ impl EffectCounters {
                 effect: "reflections",
                 light: None,
                 rays: self.reflection_rays,
+                lookups: 0,
+                texel_probes: 0,
                 worker_ms: self.reflection_s * 1e3,
             });
         }
@@ -113,6 +143,9 @@ pub struct EffectStats {
     pub light: Option<String>,
     /// Rays cast for it.
     pub rays: u64,
+    /// Texture lookups (textures only) and the bilinear probes they took.
+    pub lookups: u64,
+    pub texel_probes: u64,
     /// Time the render's workers spent on it, summed over threads (shadow
     /// time is measured for all lights together and shared out by rays).
     pub worker_ms: f64,
@@ -173,6 +206,7 @@ mod tests {
             shadow_s: 0.004,
             reflection_rays: 7,
             reflection_s: 0.001,
+            ..EffectCounters::default()
         });
         let report = c.report(&plan, &scene);
         assert_eq!(report.len(), 3);

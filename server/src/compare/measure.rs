@@ -169,6 +169,7 @@ fn measure_algorithm(
         height: sweep.size.1,
         aa: cell.aa,
         precision: cell.precision,
+        texture_filter: Default::default(),
     };
     let run = || {
         pool.install(|| render(&scene.prepared, &request))
@@ -306,6 +307,7 @@ impl Reference {
             height,
             aa,
             precision: Precision::F32,
+            texture_filter: Default::default(),
         };
         let run = |aa| {
             render(prepared, &request(aa))

@@ -1,9 +1,11 @@
 //! Effects run only when the scene calls for them, each counted; secondary rays
 //! are watertight; and every algorithm shades the same image with effects on.
 
+use continuum::metrics::flip_mean;
 use continuum::scene::Scene;
 use continuum::shade::secondary::{Rays, intersect};
-use continuum::{AlgorithmId, Family, PreparedScene};
+use continuum::shade::texture::TextureFilter;
+use continuum::{AaMode, AlgorithmId, Family, PreparedScene, RenderRequest};
 use continuum_tests::{builtin_scenes, prepared, render_with};
 use glam::Vec3;
 
@@ -27,7 +29,7 @@ fn a_scene_pays_only_for_the_effects_it_calls_for() {
         let wants = scene.scene.effects();
         let report = rays(&scene, AlgorithmId::ThreeDBrute);
         let ran = |effect: &str| report.iter().any(|(e, _, _)| e == effect);
-        for effect in ["shadows", "reflections"] {
+        for effect in ["textures", "shadows", "reflections"] {
             assert_eq!(
                 ran(effect),
                 wants.contains(&effect),
@@ -35,8 +37,19 @@ fn a_scene_pays_only_for_the_effects_it_calls_for() {
                 ran(effect)
             );
         }
-        // Whatever ran cast rays (every effect scene shows its effect from its first camera).
-        assert!(report.iter().all(|(_, _, n)| *n > 0), "{name}: {report:?}");
+        // Whatever ran did work (every effect scene shows its effect from its first camera).
+        let out = render_with(
+            &scene,
+            AlgorithmId::ThreeDBrute,
+            &scene.scene.first_camera(),
+            SIZE.0,
+            SIZE.1,
+        );
+        assert!(
+            out.stats.effects.iter().all(|e| e.rays + e.lookups > 0),
+            "{name}: {:?}",
+            out.stats.effects
+        );
     }
     assert!(
         prepared("bunny").scene.effects().is_empty(),
@@ -76,7 +89,7 @@ fn turning_one_lights_shadows_off_removes_exactly_its_rays() {
 
 #[test]
 fn every_algorithm_shades_the_same_image_with_effects() {
-    for name in ["shadows", "mirror", "fig8"] {
+    for name in ["shadows", "mirror", "fig8", "checker"] {
         let scene = prepared(name);
         for camera in scene.scene.all_cameras() {
             let reference = render_with(&scene, AlgorithmId::ThreeDBrute, &camera, SIZE.0, SIZE.1);
@@ -97,7 +110,11 @@ fn every_algorithm_shades_the_same_image_with_effects() {
                     camera.name
                 );
                 let counts = |o: &continuum::RenderOutput| {
-                    o.stats.effects.iter().map(|e| e.rays).collect::<Vec<_>>()
+                    o.stats
+                        .effects
+                        .iter()
+                        .map(|e| (e.rays, e.lookups, e.texel_probes))
+                        .collect::<Vec<_>>()
                 };
                 assert_eq!(
                     counts(&out),
@@ -176,4 +193,67 @@ fn secondary_rays_from_inside_a_closed_mesh_hit_it_exactly_once() {
         assert!(rays.occluded(origin, dir, 0.0, f32::INFINITY, u32::MAX));
         assert!(!rays.occluded(origin, dir, 0.0, hit.t * 0.999, u32::MAX));
     }
+}
+
+/// A render of `scene` from `camera` with `aa` and `filter`.
+fn render_filtered(
+    scene: &PreparedScene,
+    camera: &str,
+    aa: AaMode,
+    filter: TextureFilter,
+) -> continuum::RenderOutput {
+    let request = RenderRequest {
+        algorithm: AlgorithmId::ThreeDBrute,
+        oracles: None,
+        camera: scene.scene.camera(camera).expect("a camera of the scene"),
+        width: 192,
+        height: 108,
+        aa,
+        precision: Default::default(),
+        texture_filter: filter,
+    };
+    continuum::render(scene, &request).expect("renders")
+}
+
+#[test]
+fn trilinear_and_anisotropic_filtering_alias_less_than_nearest() {
+    // Texture aliasing on the grazing checkerboard: each filter's one sample per
+    // pixel against 256 nearest-filtered samples per pixel (the texture
+    // integrated over the pixel), in mean FLIP.
+    let scene = prepared("checker");
+    let reference = render_filtered(&scene, "grazing", AaMode::Ssaa(256), TextureFilter::Nearest);
+    let error = |filter| {
+        let out = render_filtered(&scene, "grazing", AaMode::None, filter);
+        assert_eq!(
+            out.hashes.triangle_id,
+            render_filtered(&scene, "grazing", AaMode::None, TextureFilter::Nearest)
+                .hashes
+                .triangle_id
+        );
+        flip_mean(
+            &reference.framebuffer.color,
+            &out.framebuffer.color,
+            192,
+            108,
+        )
+    };
+    let nearest = error(TextureFilter::Nearest);
+    let bilinear = error(TextureFilter::Bilinear);
+    let trilinear = error(TextureFilter::Trilinear);
+    let anisotropic = error(TextureFilter::Anisotropic(16));
+    eprintln!(
+        "mean FLIP: nearest {nearest:.4}, bilinear {bilinear:.4}, trilinear {trilinear:.4}, anisotropic:16 {anisotropic:.4}"
+    );
+    assert!(
+        trilinear < nearest,
+        "trilinear {trilinear} vs nearest {nearest}"
+    );
+    assert!(
+        anisotropic < nearest,
+        "anisotropic {anisotropic} vs nearest {nearest}"
+    );
+    assert!(
+        anisotropic < trilinear,
+        "anisotropic {anisotropic} vs trilinear {trilinear}: sharper along the long axis"
+    );
 }

@@ -80,6 +80,7 @@ fn the_checks_catch_double_coverage_holes_wrong_triangles_and_bad_depth() {
             height: 64,
             aa: continuum::AaMode::None,
             precision: Default::default(),
+            texture_filter: Default::default(),
         },
     )
     .expect("renders");

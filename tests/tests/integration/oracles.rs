@@ -86,6 +86,7 @@ fn bad_oracles_are_errors_naming_the_field() {
                 height: 8,
                 aa: continuum::AaMode::None,
                 precision: Default::default(),
+                texture_filter: Default::default(),
             },
         )
         .expect_err(text);

@@ -179,6 +179,7 @@ fn incremental_evaluation_decides_like_direct_evaluation() {
             height: 32,
             aa: continuum::AaMode::None,
             precision: Default::default(),
+            texture_filter: Default::default(),
         },
     )
     .unwrap_err();
@@ -245,6 +246,7 @@ fn unsupported_pairings_are_errors_listing_the_supported_ones() {
                     height: 16,
                     aa: continuum::AaMode::None,
                     precision: Default::default(),
+                    texture_filter: Default::default(),
                 },
             );
             let served = matches!(
