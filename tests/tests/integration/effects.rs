@@ -257,3 +257,106 @@ fn trilinear_and_anisotropic_filtering_alias_less_than_nearest() {
         "anisotropic {anisotropic} vs trilinear {trilinear}: sharper along the long axis"
     );
 }
+
+#[test]
+fn a_gltf_base_colour_texture_is_decoded_and_mapped() {
+    // A quad with TEXCOORD_0 and an embedded 2×1 PNG: red on the left, green
+    // on the right (glTF's uv origin is the image's top-left corner).
+    let mut png = Vec::new();
+    image::RgbaImage::from_raw(2, 1, vec![255, 0, 0, 255, 0, 255, 0, 255])
+        .expect("2×1 texels")
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .expect("PNG encoding");
+    let positions: [[f32; 3]; 4] = [
+        [-1.0, -1.0, 0.0],
+        [1.0, -1.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [-1.0, 1.0, 0.0],
+    ];
+    let uvs: [[f32; 2]; 4] = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]];
+    let indices: [u16; 6] = [0, 1, 2, 0, 2, 3];
+    let mut bin: Vec<u8> = positions
+        .iter()
+        .flatten()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    let uv_at = bin.len();
+    bin.extend(uvs.iter().flatten().flat_map(|v| v.to_le_bytes()));
+    let index_at = bin.len();
+    bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+    bin.extend([0, 0]);
+    let image_at = bin.len();
+    bin.extend(&png);
+    let json = serde_json::json!({
+        "asset": { "version": "2.0" },
+        "scene": 0,
+        "scenes": [{ "nodes": [0] }],
+        "nodes": [{ "mesh": 0 }],
+        "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0, "TEXCOORD_0": 1 }, "indices": 2, "material": 0 }] }],
+        "materials": [{ "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 } } }],
+        "textures": [{ "source": 0 }],
+        "images": [{ "bufferView": 3, "mimeType": "image/png" }],
+        "buffers": [{ "byteLength": bin.len() }],
+        "bufferViews": [
+            { "buffer": 0, "byteOffset": 0, "byteLength": uv_at },
+            { "buffer": 0, "byteOffset": uv_at, "byteLength": index_at - uv_at },
+            { "buffer": 0, "byteOffset": index_at, "byteLength": 12 },
+            { "buffer": 0, "byteOffset": image_at, "byteLength": png.len() }
+        ],
+        "accessors": [
+            { "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1.0, -1.0, 0.0], "max": [1.0, 1.0, 0.0] },
+            { "bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2" },
+            { "bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR" }
+        ]
+    });
+    let scene =
+        continuum::scene::load_gltf_slice(&continuum_tests::glb(&json, &bin), "textured-quad")
+            .expect("the glb loads");
+    assert_eq!(scene.effects(), vec!["textures"]);
+    let prepared = PreparedScene::new(scene);
+    assert!(
+        prepared.textures.iter().all(Result::is_ok),
+        "{:?}",
+        prepared
+            .textures
+            .iter()
+            .filter_map(|t| t.as_ref().err())
+            .collect::<Vec<_>>()
+    );
+    let camera = continuum::Camera {
+        name: "front".into(),
+        eye: Vec3::new(0.0, 0.0, 3.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        viewport: continuum::Viewport::Perspective { fov_y_deg: 60.0 },
+        near: None,
+    };
+    let request = RenderRequest {
+        algorithm: AlgorithmId::Raycast,
+        oracles: None,
+        camera,
+        width: 64,
+        height: 64,
+        aa: AaMode::None,
+        precision: Default::default(),
+        texture_filter: TextureFilter::Nearest,
+    };
+    let out = continuum::render(&prepared, &request).expect("renders");
+    let textures = out
+        .stats
+        .effects
+        .iter()
+        .find(|e| e.effect == "textures")
+        .expect("textures ran");
+    let covered = out
+        .framebuffer
+        .triangle_id
+        .iter()
+        .filter(|&&id| id != continuum::BACKGROUND)
+        .count() as u64;
+    assert_eq!(textures.lookups, covered, "one lookup per shaded sample");
+    let pixel = |x: u32, y: u32| out.framebuffer.color[(y * 64 + x) as usize];
+    let (left, right) = (pixel(20, 32), pixel(44, 32));
+    assert!(left[0] > 200 && left[1] < 40, "left {left:?}");
+    assert!(right[1] > 200 && right[0] < 40, "right {right:?}");
+}
