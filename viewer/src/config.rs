@@ -12,7 +12,7 @@ use continuum::{AaMode, AlgorithmId, Camera, Precision, RenderRequest, Scene};
 /// Whether `path` names a scene file or a model the loaders read.
 pub fn has_scene_extension(path: &Path) -> bool {
     path.extension().is_some_and(|e| {
-        ["toml", "gltf", "glb", "obj"]
+        continuum::scene::SCENE_EXTENSIONS
             .iter()
             .any(|x| e.eq_ignore_ascii_case(x))
     })

@@ -356,6 +356,9 @@ impl Scene {
     }
 }
 
+/// The file extensions [`load_path`] reads (lower case).
+pub const SCENE_EXTENSIONS: [&str; 4] = ["toml", "gltf", "glb", "obj"];
+
 /// Loads a scene from a path, by extension: `.gltf`/`.glb`, `.obj`, `.toml`.
 pub fn load_path(path: &Path) -> Result<Scene, SceneError> {
     let ext = path

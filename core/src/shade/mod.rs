@@ -103,8 +103,14 @@ impl<'a> Shader<'a> {
     ) -> Vec3 {
         let point = origin + dir * depth;
         let view_dir = dir.normalize_or_zero();
-        let normal = self.shading_normal(id, origin, dir);
         let scene = &self.scene.scene;
+        let material = &scene.materials[scene.mesh.material_ids[id as usize] as usize];
+        let textured = material.base_color_texture.is_some() && !scene.mesh.uvs.is_empty();
+        // The §3.2 barycentrics, once per sample, when normals or texture
+        // coordinates are interpolated.
+        let lambda = (textured || !scene.mesh.normals.is_empty())
+            .then(|| barycentrics(&self.scene.triangles[id as usize], origin, dir));
+        let normal = self.shading_normal(id, lambda, dir);
 
         // 1. Direct light: Lambert per light, each shadow-casting light's term
         // only where its shadow ray reaches it (primary surfaces only, Fig. 8).
@@ -141,7 +147,6 @@ impl<'a> Shader<'a> {
             }
             lit += Vec3::from(light.color).min(Vec3::ONE) * lambert;
         }
-        let material = &scene.materials[scene.mesh.material_ids[id as usize] as usize];
         let mut base = Vec3::new(
             material.base_color[0],
             material.base_color[1],
@@ -149,10 +154,10 @@ impl<'a> Shader<'a> {
         );
         if let Some(texture) = &material.base_color_texture
             && let Some(Ok(chain)) = self.scene.textures.get(texture.image)
-            && !scene.mesh.uvs.is_empty()
+            && let Some(lambda) = lambda.filter(|_| textured)
         {
             let start = Instant::now();
-            let (color, probes) = self.texture_lookup(chain, id, at, origin, dir);
+            let (color, probes) = self.texture_lookup(chain, id, at, lambda);
             effects.texture_lookups += 1;
             effects.texture_probes += u64::from(probes);
             effects.texture_s += start.elapsed().as_secs_f64();
@@ -177,8 +182,8 @@ impl<'a> Shader<'a> {
         local * (1.0 - r) + reflected * r
     }
 
-    /// Triangle `id`'s texture at the sample. Its coordinates are interpolated
-    /// with the §3.2 barycentrics; their derivatives come from the sample's 2×2
+    /// Triangle `id`'s texture at the sample, whose §3.2 barycentrics are
+    /// `lambda`. The coordinates' derivatives come from the sample's 2×2
     /// pixel quad — the rays through the quad's first pixel and its right and
     /// lower neighbours, all met with this triangle's plane (`ddx_coarse`, the
     /// same in every algorithm, `raycast` included). A reflected surface (`at`
@@ -188,17 +193,16 @@ impl<'a> Shader<'a> {
         chain: &texture::MipChain,
         id: u32,
         at: Option<(f32, f32)>,
-        origin: Vec3,
-        dir: Vec3,
+        lambda: [f32; 3],
     ) -> (glam::Vec4, u32) {
         let mesh = &self.scene.scene.mesh;
         let corners = &self.scene.triangles[id as usize];
         let [a, b, c] = mesh.triangles[id as usize];
-        let uv_along = |o: Vec3, d: Vec3| {
-            let l = barycentrics(corners, o, d);
+        let uv_of = |l: [f32; 3]| {
             mesh.uvs[a as usize] * l[0] + mesh.uvs[b as usize] * l[1] + mesh.uvs[c as usize] * l[2]
         };
-        let uv = uv_along(origin, dir);
+        let uv_along = |o: Vec3, d: Vec3| uv_of(barycentrics(corners, o, d));
+        let uv = uv_of(lambda);
         let Some((x, y)) = at else {
             return chain.sample(uv, Vec2::ZERO, Vec2::ZERO, TextureFilter::Bilinear);
         };
@@ -215,23 +219,22 @@ impl<'a> Shader<'a> {
         chain.sample(uv, ddx, ddy, self.filter)
     }
 
-    /// The unit normal that shades triangle `id` where the ray meets it, facing
-    /// the ray: interpolated from the vertex normals with the perspective-correct
-    /// barycentrics `λ_i = V_i / ΣV` (paper §3.2) when the mesh has them, the
-    /// face normal otherwise.
-    fn shading_normal(&self, id: u32, origin: Vec3, dir: Vec3) -> Vec3 {
+    /// The unit normal that shades triangle `id` where the ray along `dir`
+    /// meets it, facing the ray: interpolated from the vertex normals with the
+    /// perspective-correct barycentrics `λ_i = V_i / ΣV` (paper §3.2), `lambda`,
+    /// when the mesh has them, the face normal otherwise.
+    fn shading_normal(&self, id: u32, lambda: Option<[f32; 3]>, dir: Vec3) -> Vec3 {
         let face = self.scene.face_normals[id as usize];
         let toward = if face.dot(dir) > 0.0 { -1.0 } else { 1.0 };
         let mesh = &self.scene.scene.mesh;
-        if mesh.normals.is_empty() {
+        let Some(lambda) = lambda.filter(|_| !mesh.normals.is_empty()) else {
             return face * toward;
-        }
+        };
         let [a, b, c] = mesh.triangles[id as usize];
         let vertex = [a, b, c].map(|v| mesh.normals[v as usize]);
         if vertex.contains(&Vec3::ZERO) {
             return face * toward;
         }
-        let lambda = secondary::barycentrics(&self.scene.triangles[id as usize], origin, dir);
         let n = vertex[0] * lambda[0] + vertex[1] * lambda[1] + vertex[2] * lambda[2];
         match n.try_normalize() {
             Some(n) => n * toward,

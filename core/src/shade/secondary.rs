@@ -32,17 +32,21 @@ fn owns_edge_tie(n: Vec3) -> bool {
 /// construction, from the same signed volumes that decide coverage.
 #[inline]
 pub fn barycentrics(p: &[Vec3; 3], origin: Vec3, dir: Vec3) -> [f32; 3] {
-    let q = [p[0] - origin, p[1] - origin, p[2] - origin];
-    let v = [
-        q[1].cross(q[2]).dot(dir),
-        q[2].cross(q[0]).dot(dir),
-        q[0].cross(q[1]).dot(dir),
-    ];
+    let (_, v) = signed_volumes(p, origin, dir);
     let total = v[0] + v[1] + v[2];
     if total == 0.0 || !total.is_finite() {
         return [1.0 / 3.0; 3];
     }
     [v[0] / total, v[1] / total, v[2] / total]
+}
+
+/// The edge vectors `n_i = (p_{i+1} − o) × (p_{i+2} − o)` of `p` seen from
+/// `origin`, and the signed volumes `V_i = n_i · dir` (paper §3.1).
+#[inline]
+fn signed_volumes(p: &[Vec3; 3], origin: Vec3, dir: Vec3) -> ([Vec3; 3], [f32; 3]) {
+    let q = [p[0] - origin, p[1] - origin, p[2] - origin];
+    let n = [q[1].cross(q[2]), q[2].cross(q[0]), q[0].cross(q[1])];
+    (n, [n[0].dot(dir), n[1].dot(dir), n[2].dot(dir)])
 }
 
 /// The ray `origin + t·dir` against triangle `p`, for `t` in `(t_min, t_max)`.
@@ -54,10 +58,7 @@ pub fn intersect(
     t_min: f32,
     t_max: f32,
 ) -> Option<(f32, [f32; 3])> {
-    // Vertices relative to the origin; edge vectors n_i = q_{i+1} × q_{i+2}.
-    let q = [p[0] - origin, p[1] - origin, p[2] - origin];
-    let n = [q[1].cross(q[2]), q[2].cross(q[0]), q[0].cross(q[1])];
-    let v = [n[0].dot(dir), n[1].dot(dir), n[2].dot(dir)];
+    let (n, v) = signed_volumes(p, origin, dir);
     // All three the same sign (zeros decided by the tie rule, oriented by
     // that sign); NaN compares false and misses.
     let sign = if v.iter().all(|&x| x >= 0.0) {
@@ -67,13 +68,11 @@ pub fn intersect(
     } else {
         return None;
     };
-    let inside = |sign: f32| {
-        (0..3).all(|i| {
-            let s = v[i] * sign;
-            s > 0.0 || (s == 0.0 && owns_edge_tie(n[i] * sign))
-        })
-    };
-    if !inside(sign) {
+    let inside = (0..3).all(|i| {
+        let s = v[i] * sign;
+        s > 0.0 || (s == 0.0 && owns_edge_tie(n[i] * sign))
+    });
+    if !inside {
         return None;
     }
     let total = v[0] + v[1] + v[2];
@@ -87,7 +86,7 @@ pub fn intersect(
     if denom == 0.0 {
         return None;
     }
-    let t = normal.dot(q[0]) / denom;
+    let t = normal.dot(p[0] - origin) / denom;
     (t > t_min && t < t_max).then_some((t, lambda))
 }
 
