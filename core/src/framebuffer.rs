@@ -16,6 +16,13 @@ pub fn wins_depth_test(w: f32, id: u32, depth: f32, stored_id: u32) -> bool {
     w < depth || (w == depth && id < stored_id)
 }
 
+/// Whether triangle `id` is see-through under the per-triangle `opacity`
+/// (empty: every triangle opaque).
+#[inline(always)]
+pub(crate) fn is_see_through(opacity: &[f32], id: u32) -> bool {
+    !opacity.is_empty() && opacity[id as usize] < 1.0
+}
+
 /// All per-pixel buffers of one render, row-major, `y` down. With anti-aliasing
 /// the samples of a pixel are resolved into it: `color` is the box-filtered
 /// colour, `depth` and `triangle_id` are those of the pattern's first sample,
@@ -43,6 +50,10 @@ pub struct Framebuffer {
     /// (and CSAA coverage masks), so renders can be compared sample by sample;
     /// empty without anti-aliasing, where `triangle_id` is the whole story.
     pub sample_digest: Vec<u64>,
+    /// With transparency in the scene: per pixel, the transparent fragments
+    /// blended into it, summed over its stored samples (a tessellated pane
+    /// over a sample gives exactly one); empty otherwise.
+    pub blended: Vec<u32>,
 }
 
 impl Framebuffer {
@@ -57,6 +68,7 @@ impl Framebuffer {
             edge_evals: vec![0; n],
             coverage_writes: vec![0; n],
             sample_digest: Vec::new(),
+            blended: Vec::new(),
         }
     }
 
@@ -84,6 +96,9 @@ impl Framebuffer {
         if !tile.sample_digest.is_empty() && self.sample_digest.is_empty() {
             self.sample_digest = vec![0; self.color.len()];
         }
+        if !tile.blended.is_empty() && self.blended.is_empty() {
+            self.blended = vec![0; self.color.len()];
+        }
         for y in y0..y1 {
             let src = (y - y0) as usize * w;
             let dst = y as usize * self.width as usize + x0 as usize;
@@ -94,6 +109,9 @@ impl Framebuffer {
             self.coverage_writes[dst..dst + w].copy_from_slice(&tile.coverage_writes[src..src + w]);
             if !tile.sample_digest.is_empty() {
                 self.sample_digest[dst..dst + w].copy_from_slice(&tile.sample_digest[src..src + w]);
+            }
+            if !tile.blended.is_empty() {
+                self.blended[dst..dst + w].copy_from_slice(&tile.blended[src..src + w]);
             }
         }
     }
@@ -111,12 +129,25 @@ pub(crate) struct ResolvedTile {
     pub edge_evals: Vec<u32>,
     pub coverage_writes: Vec<u32>,
     pub sample_digest: Vec<u64>,
+    /// Transparent fragments blended per pixel (empty without transparency).
+    pub blended: Vec<u32>,
     /// Coverage writes per stored sample: zero, one, many.
     pub histogram: CoverageHistogram,
     /// Shading evaluations made.
     pub shading_samples: u64,
     /// What the tile's effect rays cost.
     pub effects: crate::shade::plan::EffectCounters,
+}
+
+/// A covered sample of a see-through triangle: kept beside the w-buffer, not
+/// tested against it, until the resolve sorts the sample's fragments by depth
+/// and blends those in front of its opaque surface (an A-buffer).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fragment {
+    /// Index into the tile's sample buffers.
+    pub sample: u32,
+    pub w: f32,
+    pub id: u32,
 }
 
 /// Pixels of a row the coverage kernel handles at once (its CSAA scratch).
@@ -161,13 +192,24 @@ pub struct TileBuffer<'p> {
     pub(crate) scratch_depths: Vec<f32>,
     /// Farthest depth per cell (`+∞` while any sample of it is empty).
     pub hiz: Vec<f32>,
+    /// Opacity per triangle id ([`crate::PreparedScene::triangle_opacity`]);
+    /// empty when every triangle is opaque.
+    pub opacity: &'p [f32],
+    /// Covered samples of see-through triangles, in no particular order.
+    pub fragments: Vec<Fragment>,
     hiz_columns: u32,
     /// Has a stored depth decreased since the last [`TileBuffer::update_hiz`]?
     depth_lowered: bool,
 }
 
 impl<'p> TileBuffer<'p> {
-    pub fn new(x0: u32, y0: u32, x1: u32, y1: u32, pattern: &'p SamplePattern) -> TileBuffer<'p> {
+    /// Buffers for the pixels `x0..x1 × y0..y1`; `opacity` per triangle id
+    /// (empty: all opaque) tells which triangles leave fragments.
+    pub fn new(
+        (x0, y0, x1, y1): (u32, u32, u32, u32),
+        pattern: &'p SamplePattern,
+        opacity: &'p [f32],
+    ) -> TileBuffer<'p> {
         let pixels = ((x1 - x0) * (y1 - y0)) as usize;
         let samples = pixels * pattern.stored;
         let hiz_columns = (x1 - x0).div_ceil(HIZ_CELL);
@@ -204,6 +246,8 @@ impl<'p> TileBuffer<'p> {
                 Vec::new()
             },
             hiz: vec![f32::INFINITY; (hiz_columns * hiz_rows) as usize],
+            opacity,
+            fragments: Vec::new(),
             hiz_columns,
             depth_lowered: false,
         }
@@ -232,6 +276,7 @@ impl<'p> TileBuffer<'p> {
         let cells = (self.hiz_columns * (y1 - y0).div_ceil(HIZ_CELL)) as usize;
         self.hiz.clear();
         self.hiz.resize(cells, f32::INFINITY);
+        self.fragments.clear();
         self.depth_lowered = false;
     }
 
@@ -252,12 +297,28 @@ impl<'p> TileBuffer<'p> {
         ((y - self.y0) * (self.x1 - self.x0) + (x - self.x0)) as usize
     }
 
+    /// Whether triangle `id` leaves fragments instead of writing the w-buffer.
+    #[inline(always)]
+    pub fn is_transparent(&self, id: u32) -> bool {
+        is_see_through(self.opacity, id)
+    }
+
     /// A covered sample (index `i` into the sample buffers): count the coverage
-    /// write, then the w-buffer test with depth ties going to the smaller
-    /// triangle id. Returns whether the sample now holds the triangle.
+    /// write, then — for an opaque triangle — the w-buffer test with depth ties
+    /// going to the smaller triangle id; a see-through triangle's sample is
+    /// kept as a [`Fragment`] instead. Returns whether the sample now holds
+    /// the triangle.
     #[inline(always)]
     pub fn write(&mut self, i: usize, w: f32, id: u32) -> bool {
         self.coverage_writes[i] += 1;
+        if self.is_transparent(id) {
+            self.fragments.push(Fragment {
+                sample: i as u32,
+                w,
+                id,
+            });
+            return false;
+        }
         let (d, t) = (self.depth[i], self.triangle_id[i]);
         if wins_depth_test(w, id, d, t) {
             self.depth_lowered |= w < d;

@@ -32,6 +32,9 @@ pub struct PreparedScene {
     /// Decoded textures with their mip chains, one per `scene.images` entry
     /// (or why it could not be decoded); empty when no material is textured.
     pub textures: Vec<Result<MipChain, String>>,
+    /// Opacity per triangle id, from its material; empty when every material
+    /// is opaque (the effect plan runs no transparency then).
+    pub triangle_opacity: Vec<f32>,
     /// The drawable triangles on the GPU, uploaded by the first `gpu-raster` render.
     #[cfg(feature = "gpu")]
     pub(crate) gpu_mesh: std::sync::OnceLock<Result<crate::gpu::GpuMesh, crate::gpu::GpuError>>,
@@ -86,8 +89,18 @@ impl PreparedScene {
         } else {
             Vec::new()
         };
+        // Per-triangle opacity only when a material is see-through.
+        let triangle_opacity = if scene.materials.iter().any(|m| m.opacity < 1.0) {
+            mesh.material_ids
+                .iter()
+                .map(|&m| scene.materials[m as usize].opacity)
+                .collect()
+        } else {
+            Vec::new()
+        };
         PreparedScene {
             textures,
+            triangle_opacity,
             triangles,
             face_normals,
             drawable,
@@ -112,6 +125,7 @@ impl PreparedScene {
             + self.face_normals.len() * 12
             + self.drawable.len() * 4
             + self.slot_triangles.len() * 4
+            + self.triangle_opacity.len() * 4
             + self.bvh.cwbvh.nodes.len() * (80 + 192)
             + self.bvh.cwbvh.primitive_indices.len() * 4
             + self
@@ -120,6 +134,12 @@ impl PreparedScene {
                 .flatten()
                 .map(|t| t.texel_count() * 16)
                 .sum::<usize>()
+    }
+
+    /// Whether triangle `id` is see-through (its material's opacity below 1).
+    #[inline(always)]
+    pub fn is_transparent(&self, id: u32) -> bool {
+        crate::framebuffer::is_see_through(&self.triangle_opacity, id)
     }
 
     /// Triangle count, degenerate ones included.

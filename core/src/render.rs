@@ -167,6 +167,13 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
         .into());
     }
     let shader = Shader::new(scene, &view, request.texture_filter);
+    if pipeline == Pipeline::Gpu && shader.plan().transparency {
+        return Err(FieldError::new(
+            "algorithm",
+            "gpu-raster draws opaque surfaces only; this scene has see-through materials (opacity < 1)",
+        )
+        .into());
+    }
     if pipeline == Pipeline::Gpu {
         render_on_gpu(scene, request, &view, &shader, &mut fb, &mut stats)?;
     } else {
@@ -174,6 +181,7 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
             view: &view,
             pattern: &pattern,
             shader,
+            opacity: &scene.triangle_opacity,
         };
         algorithm::run(
             pipeline,

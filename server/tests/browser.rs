@@ -129,7 +129,19 @@ fn the_page_renders_switches_maps_and_compares() {
         assert_ne!(heat, src, "the image switched to the heat map");
         std::fs::write(shots.join("browser-heat-map.png"), client.screenshot().await.expect("screenshot")).expect("save");
 
-        // 3. The compare view: two images, their difference, the timing bars.
+        // 3. Effects: a texture filter on the checkerboard, then the glass panes;
+        // the stats table lists what each effect cost.
+        client.find(Locator::Css("button[data-view=color]")).await.expect("button").click().await.expect("click");
+        client.find(Locator::Id("texture-filter")).await.expect("filter").send_keys("anisotropic:8\n").await.expect("type");
+        client.find(Locator::Id("scene")).await.expect("scene").select_by_value("checker").await.expect("select checker");
+        let stats = wait_until("checker", "stats", "lookups").await;
+        assert!(stats.contains("textures"), "{stats}");
+        client.find(Locator::Id("scene")).await.expect("scene").select_by_value("pane").await.expect("select pane");
+        let stats = wait_until("pane", "stats", "fragments").await;
+        assert!(stats.contains("transparency") && stats.contains("shadows"), "{stats}");
+        std::fs::write(shots.join("browser-pane.png"), client.screenshot().await.expect("screenshot")).expect("save");
+
+        // 4. The compare view: two images, their difference, the timing bars.
         client.find(Locator::Id("show-compare")).await.expect("compare").click().await.expect("click");
         let caption = wait_until("compare", "cap-diff", "pixels differ").await;
         assert!(caption.contains("difference"), "{caption}");

@@ -17,11 +17,18 @@
 //!   turns silhouettes ragged.) This depends only on what the stored samples
 //!   hold — not on drawing order or culling — so it is the same in every
 //!   algorithm.
+//! - Transparency (an A-buffer): the fragments see-through triangles left at a
+//!   stored sample are sorted by depth (ties to the smaller id) and those in
+//!   front of its opaque surface are blended over it, far to near, in linear
+//!   light: `c ← α·c_f + (1 − α)·c`. The order depends only on the fragments,
+//!   so every algorithm that finds the same fragments blends the same colour.
+
+use std::time::Instant;
 
 use glam::Vec3;
 
 use crate::camera::View;
-use crate::framebuffer::{BACKGROUND, ResolvedTile, TileBuffer, wins_depth_test};
+use crate::framebuffer::{BACKGROUND, Fragment, ResolvedTile, TileBuffer, wins_depth_test};
 use crate::shade::plan::EffectCounters;
 use crate::shade::{BACKGROUND_COLOR, OUTSIDE_VIEWPORT_COLOR, Shader, encode_rgb, linear_rgb};
 use crate::stats::CoverageHistogram;
@@ -43,6 +50,59 @@ fn mix(h: u64, v: u32) -> u64 {
         .rotate_left(29)
 }
 
+/// A tile's fragments grouped by sample (a counting sort), each group sorted
+/// near to far (ties to the smaller id).
+struct FragmentLayers {
+    /// Fragments of sample `j` are `sorted[start[j]..start[j + 1]]`; empty
+    /// when the tile has none.
+    start: Vec<u32>,
+    sorted: Vec<Fragment>,
+}
+
+impl FragmentLayers {
+    fn of(tile: &TileBuffer) -> FragmentLayers {
+        if tile.fragments.is_empty() {
+            return FragmentLayers {
+                start: Vec::new(),
+                sorted: Vec::new(),
+            };
+        }
+        let samples = tile.pixels * tile.pattern.stored;
+        let mut start = vec![0u32; samples + 1];
+        for f in &tile.fragments {
+            start[f.sample as usize + 1] += 1;
+        }
+        for j in 0..samples {
+            start[j + 1] += start[j];
+        }
+        let mut fill = start.clone();
+        let mut sorted = vec![tile.fragments[0]; tile.fragments.len()];
+        for f in &tile.fragments {
+            sorted[fill[f.sample as usize] as usize] = *f;
+            fill[f.sample as usize] += 1;
+        }
+        for j in 0..samples {
+            sorted[start[j] as usize..start[j + 1] as usize]
+                .sort_unstable_by(|a, b| a.w.total_cmp(&b.w).then(a.id.cmp(&b.id)));
+        }
+        FragmentLayers { start, sorted }
+    }
+
+    /// The fragments of sample `j`, near to far.
+    #[inline]
+    fn at(&self, j: usize) -> &[Fragment] {
+        if self.start.is_empty() {
+            return &[];
+        }
+        &self.sorted[self.start[j] as usize..self.start[j + 1] as usize]
+    }
+
+    /// Whether any stored sample of pixel `i` has fragments.
+    fn pixel_has(&self, i: usize, pixels: usize, stored: usize) -> bool {
+        !self.start.is_empty() && (0..stored).any(|s| !self.at(s * pixels + i).is_empty())
+    }
+}
+
 /// Resolves every pixel of `tile`.
 pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> ResolvedTile {
     let pattern = tile.pattern;
@@ -58,6 +118,11 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
         edge_evals: tile.edge_evals.clone(),
         coverage_writes: vec![0; pixels],
         sample_digest: Vec::new(),
+        blended: if shader.plan().transparency {
+            vec![0; pixels]
+        } else {
+            Vec::new()
+        },
         histogram: CoverageHistogram::of(&tile.coverage_writes),
         shading_samples: 0,
         effects: EffectCounters::for_plan(shader.plan()),
@@ -96,41 +161,81 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
             }
         }
     }
+    let layers = FragmentLayers::of(tile);
+    let mut surface_color = [Vec3::ZERO; MAX_STORED];
     let mut slot_color = [Vec3::ZERO; MAX_STORED];
+    // Per pixel without per-sample shading: the colour of each transparent
+    // triangle, shaded once (as its opaque counterpart would be).
+    let mut fragment_colors: Vec<(u32, (Vec3, f32))> = Vec::new();
     for y in tile.y0..tile.y1 {
         for x in tile.x0..tile.x1 {
             let i = tile.index(x, y);
             let id_at = |s: usize| tile.triangle_id[s * pixels + i];
             let depth_at = |s: usize| tile.depth[s * pixels + i];
+            let layered = layers.pixel_has(i, pixels, stored);
             // 1. The colour each stored sample sees (one shading when they all
             // hold the same triangle and need not be shaded apart).
             // (Background samples of a non-planar view may lie on both sides
             // of the viewport's border, so they are not taken as one.)
-            let uniform = uniform[i] && (id_at(0) != BACKGROUND || view.sphere.is_none());
+            let uniform =
+                uniform[i] && !layered && (id_at(0) != BACKGROUND || view.sphere.is_none());
+            fragment_colors.clear();
+            let mut blended = 0;
             for s in 0..if uniform { 1 } else { stored } {
                 let id = id_at(s);
-                if !pattern.shade_per_sample
-                    && id != BACKGROUND
-                    && let Some(t) = (0..s).find(|&t| id_at(t) == id)
-                {
-                    slot_color[s] = slot_color[t];
-                    continue;
-                }
                 let [ox, oy] = pattern.positions[s];
-                slot_color[s] = match view.ray(x as f32 + ox, y as f32 + oy) {
-                    None => outside,
-                    Some(_) if id == BACKGROUND => background,
-                    Some((origin, dir)) => {
+                let at = (x as f32 + ox, y as f32 + oy);
+                let fragments = layers.at(s * pixels + i);
+                let shaded_before = (!pattern.shade_per_sample && id != BACKGROUND)
+                    .then(|| (0..s).find(|&t| id_at(t) == id))
+                    .flatten();
+                let ray = (shaded_before.is_none() || !fragments.is_empty())
+                    .then(|| view.ray(at.0, at.1))
+                    .flatten();
+                surface_color[s] = match (shaded_before, ray) {
+                    (Some(t), _) => surface_color[t],
+                    (None, None) => outside,
+                    (None, Some(_)) if id == BACKGROUND => background,
+                    (None, Some(ray)) => {
                         out.shading_samples += 1;
-                        let at = (x as f32 + ox, y as f32 + oy);
-                        shader.shade(id, at, (origin, dir), depth_at(s), &mut out.effects)
+                        shader.shade(id, at, ray, depth_at(s), &mut out.effects)
                     }
                 };
+                slot_color[s] = surface_color[s];
+                // 2. Transparent fragments in front of the opaque surface,
+                // blended far to near (their shading's own effects counted
+                // there too).
+                if let (false, Some(ray)) = (fragments.is_empty(), ray) {
+                    let start = Instant::now();
+                    let front = fragments
+                        .iter()
+                        .take_while(|f| wins_depth_test(f.w, f.id, depth_at(s), id))
+                        .count();
+                    for f in fragments[..front].iter().rev() {
+                        let cached = fragment_colors.iter().find(|(t, _)| *t == f.id);
+                        let (color, alpha) = match cached {
+                            Some(&(_, c)) if !pattern.shade_per_sample => c,
+                            _ => {
+                                out.shading_samples += 1;
+                                let c = shader.shade_fragment(f.id, at, ray, f.w, &mut out.effects);
+                                fragment_colors.push((f.id, c));
+                                c
+                            }
+                        };
+                        slot_color[s] = color * alpha + slot_color[s] * (1.0 - alpha);
+                    }
+                    blended += front as u32;
+                    out.effects.fragments_blended += front as u64;
+                    out.effects.transparency_s += start.elapsed().as_secs_f64();
+                }
             }
-            // 2. The box filter over the coverage samples.
+            if !out.blended.is_empty() {
+                out.blended[i] = blended;
+            }
+            // 3. The box filter over the coverage samples.
             if !anti_aliased {
                 // Exactly the stored colours, not a round trip through linear light.
-                out.color[i] = if id_at(0) != BACKGROUND {
+                out.color[i] = if id_at(0) != BACKGROUND || blended > 0 {
                     encode_rgb(slot_color[0])
                 } else if slot_color[0] == outside {
                     OUTSIDE_VIEWPORT_COLOR

@@ -466,6 +466,8 @@ pub(crate) struct TileContext<'a> {
     pub view: &'a View,
     pub pattern: &'a SamplePattern,
     pub shader: Shader<'a>,
+    /// Opacity per triangle id (empty: every triangle opaque).
+    pub opacity: &'a [f32],
 }
 
 /// A tile rendered and resolved by one worker, with what its rendering returned.
@@ -506,7 +508,11 @@ impl<'a> TileContext<'a> {
                 tile.reset(x0, y0, x1, y1);
                 tile
             }
-            None => cache.insert(TileBuffer::new(x0, y0, x1, y1, self.pattern)),
+            None => cache.insert(TileBuffer::new(
+                (x0, y0, x1, y1),
+                self.pattern,
+                self.opacity,
+            )),
         };
         let result = render(tile);
         let render_s = start.elapsed().as_secs_f64();

@@ -14,7 +14,9 @@ use super::{Pass, TileContext};
 use crate::aa::SamplePattern;
 use crate::camera::View;
 use crate::edge::Coverage;
-use crate::framebuffer::{BACKGROUND, Framebuffer, TileBuffer, wins_depth_test};
+use crate::framebuffer::{
+    BACKGROUND, Fragment, Framebuffer, TileBuffer, is_see_through, wins_depth_test,
+};
 use crate::prepared::PreparedScene;
 use crate::stats::Stats;
 
@@ -99,13 +101,25 @@ fn cast_band<T: Coverage>(
                 };
                 let (mut best_w, mut best_id, mut best_slot) = (f32::INFINITY, BACKGROUND, 0);
                 let (mut evals, mut covered) = (0u32, 0u32);
+                let j = s * pixels + i;
+                // See-through triangles leave fragments, as in the rasterizers'
+                // `TileBuffer::write`; the walk still culls beyond the nearest
+                // opaque hit, behind which no fragment shows.
+                let opacity = tile.opacity;
+                let fragments = &mut tile.fragments;
                 nodes += scene.bvh.walk(origin, direction, |k| {
                     if let Some(tri) = &setups[k as usize] {
                         evals += 1;
                         if let Some(w) = tri.sample(xs, ys) {
                             covered += 1;
                             let id = scene.slot_triangles[k as usize];
-                            if wins_depth_test(w, id, best_w, best_id) {
+                            if is_see_through(opacity, id) {
+                                fragments.push(Fragment {
+                                    sample: j as u32,
+                                    w,
+                                    id,
+                                });
+                            } else if wins_depth_test(w, id, best_w, best_id) {
                                 (best_w, best_id, best_slot) = (w, id, k);
                             }
                         }
@@ -113,7 +127,6 @@ fn cast_band<T: Coverage>(
                     best_w * CULL_MARGIN
                 });
                 tile.edge_evals[i] += evals;
-                let j = s * pixels + i;
                 tile.coverage_writes[j] = covered;
                 tile.depth[j] = best_w;
                 tile.triangle_id[j] = best_id;

@@ -477,7 +477,7 @@ pub(crate) fn render_gpu_raster(
     // 3. Resolve and shade on the CPU, as every algorithm does.
     let start = Instant::now();
     let pattern = crate::AaMode::None.pattern();
-    let mut tile = TileBuffer::new(0, 0, view.width, view.height, &pattern);
+    let mut tile = TileBuffer::new((0, 0, view.width, view.height), &pattern, &[]);
     tile.triangle_id = samples.triangle_id;
     tile.depth = samples.depth;
     tile.coverage_writes = samples.fragments.into_iter().map(u32::from).collect();

@@ -1,16 +1,17 @@
 //! glTF 2.0 (`.gltf`, `.glb`) through the `gltf` crate: every mesh and primitive of
 //! the default scene with node transforms applied, any index width, base colour
-//! factor and texture references, cameras and KHR_lights_punctual lights.
+//! factor and texture references (with their sampler's wrap modes and uv set),
+//! vertex colours, cameras and KHR_lights_punctual lights.
 
 use std::path::Path;
 use std::sync::Arc;
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 use gltf::mesh::Mode;
 
 use super::validate::{PartLocation, validate_part};
 use super::{
-    ImageRef, ImageSource, Light, LightKind, Material, Mesh, Scene, SceneError, TextureRef,
+    ImageRef, ImageSource, Light, LightKind, Material, Mesh, Scene, SceneError, TextureRef, Wrap,
 };
 use crate::camera::{Camera, Viewport};
 
@@ -241,9 +242,17 @@ fn convert_material(m: &gltf::Material) -> Material {
             .map(str::to_string)
             .unwrap_or_else(|| format!("material{}", m.index().unwrap_or(0))),
         base_color,
-        base_color_texture: pbr.base_color_texture().map(|info| TextureRef {
-            image: info.texture().source().index(),
-            tex_coord: info.tex_coord(),
+        base_color_texture: pbr.base_color_texture().map(|info| {
+            let sampler = info.texture().sampler();
+            TextureRef {
+                image: info.texture().source().index(),
+                tex_coord: info.tex_coord(),
+                wrap: [sampler.wrap_s(), sampler.wrap_t()].map(|w| match w {
+                    gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+                    gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+                    gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+                }),
+            }
         }),
         emissive: m.emissive_factor(),
         opacity: if blend { base_color[3] } else { 1.0 },
@@ -279,10 +288,26 @@ fn read_primitive(
         .read_normals()
         .map(|n| n.map(Vec3::from).collect())
         .unwrap_or_default();
+    // The texture coordinate set the material's base-colour texture names.
+    let uv_set = prim
+        .material()
+        .pbr_metallic_roughness()
+        .base_color_texture()
+        .map_or(0, |info| info.tex_coord());
     let uvs: Vec<Vec2> = reader
-        .read_tex_coords(0)
+        .read_tex_coords(uv_set)
         .map(|t| t.into_f32().map(Vec2::from).collect())
         .unwrap_or_default();
+    let colors: Vec<Vec4> = reader
+        .read_colors(0)
+        .map(|c| c.into_rgba_f32().map(Vec4::from).collect())
+        .unwrap_or_default();
+    if let Some(v) = colors.iter().position(|c| !c.is_finite()) {
+        return Err(SceneError::Invalid {
+            location: location.to_string(),
+            problem: format!("COLOR_0 of vertex {v} is not finite"),
+        });
+    }
     let indices: Vec<u32> = match reader.read_indices() {
         Some(i) => i.into_u32().collect(),
         None => (0..positions.len() as u32).collect(),
@@ -299,10 +324,16 @@ fn read_primitive(
     } else {
         Vec::new()
     };
+    let colors = if colors.len() == positions.len() {
+        colors
+    } else {
+        Vec::new()
+    };
     Ok(Mesh {
         positions,
         normals,
         uvs,
+        colors,
         material_ids: Vec::new(),
         triangles,
     })

@@ -29,8 +29,8 @@ use crate::camera::Camera;
 /// Triangle geometry in world space, structure-of-arrays.
 ///
 /// Invariants (checked by [`Scene::validate`]): every position is finite; every index
-/// is `< positions.len()`; `material_ids.len() == triangles.len()`; `normals` and
-/// `uvs` are either empty or one per vertex.
+/// is `< positions.len()`; `material_ids.len() == triangles.len()`; `normals`,
+/// `uvs` and `colors` are either empty or one per vertex.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
     /// Vertex positions, world space.
@@ -38,8 +38,12 @@ pub struct Mesh {
     /// Per-vertex shading normals, or empty when the source has none (a zero
     /// vector marks a vertex of a part that had none).
     pub normals: Vec<Vec3>,
-    /// Per-vertex texture coordinates (set 0), or empty.
+    /// Per-vertex texture coordinates (the set the material's base-colour
+    /// texture names, else set 0), or empty.
     pub uvs: Vec<Vec2>,
+    /// Per-vertex colours (linear RGBA, glTF `COLOR_0`), multiplying the base
+    /// colour; empty when the source has none (white pads parts without).
+    pub colors: Vec<glam::Vec4>,
     /// Vertex indices, three per triangle. The index of a triangle in this list is
     /// its *triangle id* everywhere in continuum.
     pub triangles: Vec<[u32; 3]>,
@@ -64,12 +68,14 @@ impl Mesh {
         ]
     }
 
-    /// Appends `other`, offsetting its indices and material ids. Normals and uvs
-    /// stay one per vertex: the side that lacks them is padded with zeros.
+    /// Appends `other`, offsetting its indices and material ids. Normals, uvs
+    /// and colours stay one per vertex: the side that lacks them is padded
+    /// with zeros (colours with white).
     pub fn append(&mut self, other: &Mesh, material_offset: u32) {
         let base = self.positions.len();
         let with_normals = !self.normals.is_empty() || !other.normals.is_empty();
         let with_uvs = !self.uvs.is_empty() || !other.uvs.is_empty();
+        let with_colors = !self.colors.is_empty() || !other.colors.is_empty();
         self.positions.extend_from_slice(&other.positions);
         if with_normals {
             self.normals.resize(base, Vec3::ZERO);
@@ -80,6 +86,11 @@ impl Mesh {
             self.uvs.resize(base, Vec2::ZERO);
             self.uvs.extend_from_slice(&other.uvs);
             self.uvs.resize(self.positions.len(), Vec2::ZERO);
+        }
+        if with_colors {
+            self.colors.resize(base, glam::Vec4::ONE);
+            self.colors.extend_from_slice(&other.colors);
+            self.colors.resize(self.positions.len(), glam::Vec4::ONE);
         }
         let base = base as u32;
         self.triangles.extend(
@@ -185,8 +196,51 @@ impl Default for Material {
 pub struct TextureRef {
     /// Index into [`Scene::images`].
     pub image: usize,
-    /// Which texture coordinate set the texture uses.
+    /// Which texture coordinate set the texture uses (the loaders read that
+    /// set into [`Mesh::uvs`] for the material's triangles).
     pub tex_coord: u32,
+    /// How coordinates outside [0, 1] wrap, along u (glTF `wrapS`) and v (`wrapT`).
+    pub wrap: [Wrap; 2],
+}
+
+/// A texture sampler's wrap mode (glTF's three).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Wrap {
+    /// The texture tiles (glTF's default).
+    #[default]
+    Repeat,
+    /// Coordinates clamp to the edge texels.
+    ClampToEdge,
+    /// The texture tiles, every other copy mirrored.
+    MirroredRepeat,
+}
+
+impl Wrap {
+    /// The TOML words.
+    pub const WORDS: &'static str = "repeat, clamp, mirror";
+
+    pub fn parse(s: &str) -> Option<Wrap> {
+        match s {
+            "repeat" => Some(Wrap::Repeat),
+            "clamp" => Some(Wrap::ClampToEdge),
+            "mirror" => Some(Wrap::MirroredRepeat),
+            _ => None,
+        }
+    }
+
+    /// Texel `i` of a row of `n` texels, for any integer `i`.
+    #[inline]
+    pub fn texel(self, i: i64, n: u32) -> usize {
+        let n = i64::from(n);
+        (match self {
+            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::ClampToEdge => i.clamp(0, n - 1),
+            Wrap::MirroredRepeat => {
+                let m = i.rem_euclid(2 * n);
+                if m < n { m } else { 2 * n - 1 - m }
+            }
+        }) as usize
+    }
 }
 
 /// Where a texture image lives.

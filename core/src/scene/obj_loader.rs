@@ -110,6 +110,18 @@ fn build((models, materials): Loaded, file: &str, name: String) -> Result<Scene,
             .chunks_exact(2)
             .map(|c| Vec2::new(c[0], c[1]))
             .collect();
+        // Vertex colours (`v x y z r g b`, linear) only when every vertex has one.
+        let colors: Vec<glam::Vec4> = m
+            .vertex_color
+            .chunks_exact(3)
+            .map(|c| glam::Vec4::new(c[0], c[1], c[2], 1.0))
+            .collect();
+        if let Some(v) = colors.iter().position(|c| !c.is_finite()) {
+            return Err(SceneError::Invalid {
+                location: location.to_string(),
+                problem: format!("the colour of vertex {v} is not finite"),
+            });
+        }
         let material = m
             .material_id
             .filter(|&i| i < default_material as usize)
@@ -122,6 +134,11 @@ fn build((models, materials): Loaded, file: &str, name: String) -> Result<Scene,
             },
             uvs: if uvs.len() == positions.len() {
                 uvs
+            } else {
+                Vec::new()
+            },
+            colors: if colors.len() == positions.len() {
+                colors
             } else {
                 Vec::new()
             },

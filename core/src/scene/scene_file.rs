@@ -38,6 +38,7 @@
 //! opacity = 1.0
 //! reflectivity = 0.0
 //! base_color_texture = "assets/checker.png"   # optional: PNG or JPEG, sRGB, on the mesh's uvs
+//! texture_wrap = "repeat"        # or "clamp", "mirror" (with a texture)
 //! ```
 //! Unknown keys are errors that name the key.
 
@@ -49,7 +50,7 @@ use serde::Deserialize;
 use super::procedural::Generator;
 use super::{
     ImageRef, ImageSource, Light, LightKind, Material, Mesh, PartLocation, Scene, SceneError,
-    TextureRef, load_path, validate_part,
+    TextureRef, Wrap, load_path, validate_part,
 };
 use crate::camera::{Camera, Viewport};
 
@@ -147,6 +148,9 @@ pub struct MaterialEntry {
     /// A PNG or JPEG file (relative to the scene file) as the base-colour
     /// texture, on the mesh's first texture coordinates.
     pub base_color_texture: Option<String>,
+    /// How its coordinates wrap outside [0, 1]: `repeat` (default), `clamp`
+    /// or `mirror`, for both axes.
+    pub texture_wrap: Option<String>,
 }
 
 impl SceneFile {
@@ -306,6 +310,22 @@ fn build(doc: &SceneFile, file: &str, name: String, dir: &Path) -> Result<Scene,
             }
             target.reflectivity = r;
         }
+        let wrap = match m.texture_wrap.as_deref() {
+            None => Wrap::Repeat,
+            Some(word) => Wrap::parse(word).ok_or_else(|| {
+                err(format!(
+                    "material '{}': texture_wrap '{word}' is not one of {}",
+                    m.name,
+                    Wrap::WORDS
+                ))
+            })?,
+        };
+        if m.texture_wrap.is_some() && m.base_color_texture.is_none() {
+            return Err(err(format!(
+                "material '{}': texture_wrap needs a base_color_texture",
+                m.name
+            )));
+        }
         if let Some(file) = &m.base_color_texture {
             let path = dir.join(file);
             if !path.is_file() {
@@ -322,6 +342,7 @@ fn build(doc: &SceneFile, file: &str, name: String, dir: &Path) -> Result<Scene,
             scene.materials[index].base_color_texture = Some(TextureRef {
                 image: scene.images.len() - 1,
                 tex_coord: 0,
+                wrap: [wrap; 2],
             });
         }
     }

@@ -1,10 +1,12 @@
 //! Shading of visible samples: Lambert with every light of the scene (or a
 //! headlight at the eye), base colour and emission from the material, normals
 //! interpolated from the vertices where the mesh has them, and the effects the
-//! scene calls for ([`plan`]): shadow rays, reflection rays ([`secondary`]).
-//! Shading reads only the triangle id, the sample's ray and its depth, so
-//! algorithms that agree on those produce identical colours. Colours are linear
-//! until the resolve ([`crate::aa`]) encodes the filtered pixel as sRGB.
+//! scene calls for ([`plan`]): shadow rays, reflection rays ([`secondary`]),
+//! and the colour and opacity of transparent fragments. Shading reads only the
+//! triangle id and the sample's ray (the shaded point is where the ray meets
+//! the triangle's plane), so algorithms that agree on the triangle produce
+//! identical colours, whatever depth their family computed. Colours are
+//! linear until the resolve ([`crate::aa`]) encodes the filtered pixel as sRGB.
 
 pub mod plan;
 pub mod secondary;
@@ -20,7 +22,7 @@ use crate::camera::View;
 use crate::prepared::PreparedScene;
 use crate::scene::LightKind;
 use plan::{EffectCounters, EffectPlan, REFLECTION_DEPTH};
-use secondary::{Rays, barycentrics};
+use secondary::{Rays, barycentrics, plane_distance};
 use texture::TextureFilter;
 
 /// Background colour (sRGB).
@@ -71,10 +73,10 @@ impl<'a> Shader<'a> {
         &self.plan
     }
 
-    /// Linear colour of triangle `id` seen along the ray `origin + t·dir` at
-    /// depth `depth` (the ray's own parameter: `w` on planar views, the distance
-    /// on non-planar ones) from the sample at pixel position `at`; effect rays
-    /// and texture lookups are counted into `effects`.
+    /// Linear colour of triangle `id` seen along the ray `origin + t·dir`
+    /// from the sample at pixel position `at`; effect rays and texture lookups
+    /// are counted into `effects`. `depth`, the family's own ray parameter
+    /// there, stands in only where the ray runs along the triangle's plane.
     #[inline]
     pub fn shade(
         &self,
@@ -85,6 +87,22 @@ impl<'a> Shader<'a> {
         effects: &mut EffectCounters,
     ) -> Vec3 {
         self.shade_surface(id, Some(at), origin, dir, depth, 0, effects)
+            .0
+    }
+
+    /// [`Shader::shade`] for a fragment of a see-through triangle: its colour
+    /// and its opacity there — the material's opacity times the vertex
+    /// colours' and the texture's alpha (glTF alpha mode `BLEND`).
+    #[inline]
+    pub fn shade_fragment(
+        &self,
+        id: u32,
+        at: (f32, f32),
+        ray: (Vec3, Vec3),
+        depth: f32,
+        effects: &mut EffectCounters,
+    ) -> (Vec3, f32) {
+        self.shade_surface(id, Some(at), ray.0, ray.1, depth, 0, effects)
     }
 
     #[allow(
@@ -100,20 +118,26 @@ impl<'a> Shader<'a> {
         depth: f32,
         bounce: u32,
         effects: &mut EffectCounters,
-    ) -> Vec3 {
-        let point = origin + dir * depth;
+    ) -> (Vec3, f32) {
+        // The shaded point from the triangle's plane and the ray alone (not the
+        // family's own depth), so every algorithm that finds the triangle
+        // shades it alike — the 2D family included.
+        let t = plane_distance(&self.scene.triangles[id as usize], origin, dir).unwrap_or(depth);
+        let point = origin + dir * t;
         let view_dir = dir.normalize_or_zero();
         let scene = &self.scene.scene;
         let material = &scene.materials[scene.mesh.material_ids[id as usize] as usize];
         let textured = material.base_color_texture.is_some() && !scene.mesh.uvs.is_empty();
-        // The §3.2 barycentrics, once per sample, when normals or texture
-        // coordinates are interpolated.
-        let lambda = (textured || !scene.mesh.normals.is_empty())
+        let mesh = &scene.mesh;
+        // The §3.2 barycentrics, once per sample, when normals, texture
+        // coordinates or vertex colours are interpolated.
+        let lambda = (textured || !mesh.normals.is_empty() || !mesh.colors.is_empty())
             .then(|| barycentrics(&self.scene.triangles[id as usize], origin, dir));
         let normal = self.shading_normal(id, lambda, dir);
 
         // 1. Direct light: Lambert per light, each shadow-casting light's term
-        // only where its shadow ray reaches it (primary surfaces only, Fig. 8).
+        // only where its shadow ray reaches it, dimmed by the see-through
+        // surfaces it passes (primary surfaces only, Fig. 8).
         let mut lit = Vec3::ZERO;
         if scene.lights.is_empty() {
             lit = Vec3::splat(normal.dot(-view_dir).max(0.0));
@@ -128,7 +152,7 @@ impl<'a> Shader<'a> {
                     (to.normalize_or_zero(), to.length())
                 }
             };
-            let lambert = normal.dot(to_light);
+            let mut lambert = normal.dot(to_light);
             if lambert <= 0.0 {
                 continue;
             }
@@ -137,13 +161,14 @@ impl<'a> Shader<'a> {
             {
                 let start = Instant::now();
                 effects.shadow_rays[slot] += 1;
-                let shadowed = self
+                let passed = self
                     .rays
-                    .occluded(point, to_light, self.t_min, distance, id);
+                    .transmittance(point, to_light, self.t_min, distance, id);
                 effects.shadow_s += start.elapsed().as_secs_f64();
-                if shadowed {
+                if passed == 0.0 {
                     continue;
                 }
+                lambert *= passed;
             }
             lit += Vec3::from(light.color).min(Vec3::ONE) * lambert;
         }
@@ -152,23 +177,31 @@ impl<'a> Shader<'a> {
             material.base_color[1],
             material.base_color[2],
         );
+        let mut alpha = material.opacity;
+        if let Some(l) = lambda.filter(|_| !mesh.colors.is_empty()) {
+            let [a, b, c] = mesh.triangles[id as usize].map(|v| mesh.colors[v as usize]);
+            let color = a * l[0] + b * l[1] + c * l[2];
+            base *= color.truncate();
+            alpha *= color.w;
+        }
         if let Some(texture) = &material.base_color_texture
             && let Some(Ok(chain)) = self.scene.textures.get(texture.image)
             && let Some(lambda) = lambda.filter(|_| textured)
         {
             let start = Instant::now();
-            let (color, probes) = self.texture_lookup(chain, id, at, lambda);
+            let (color, probes) = self.texture_lookup((chain, texture.wrap), id, at, lambda);
             effects.texture_lookups += 1;
             effects.texture_probes += u64::from(probes);
             effects.texture_s += start.elapsed().as_secs_f64();
             base *= color.truncate();
+            alpha *= color.w;
         }
         let local = base * (AMBIENT + (1.0 - AMBIENT) * lit) + Vec3::from(material.emissive);
 
         // 2. A mirror's reflection ray, shaded where it lands.
         let r = material.reflectivity.clamp(0.0, 1.0);
         if r == 0.0 || bounce >= REFLECTION_DEPTH {
-            return local;
+            return (local, alpha);
         }
         let start = Instant::now();
         effects.reflection_rays += 1;
@@ -176,10 +209,13 @@ impl<'a> Shader<'a> {
         let hit = self.rays.closest(point, mirrored, self.t_min, id);
         effects.reflection_s += start.elapsed().as_secs_f64();
         let reflected = match hit {
-            Some(h) => self.shade_surface(h.id, None, point, mirrored, h.t, bounce + 1, effects),
+            Some(h) => {
+                self.shade_surface(h.id, None, point, mirrored, h.t, bounce + 1, effects)
+                    .0
+            }
             None => linear_rgb(BACKGROUND_COLOR),
         };
-        local * (1.0 - r) + reflected * r
+        (local * (1.0 - r) + reflected * r, alpha)
     }
 
     /// Triangle `id`'s texture at the sample, whose §3.2 barycentrics are
@@ -190,7 +226,7 @@ impl<'a> Shader<'a> {
     /// = `None`) has no quad: the full-resolution level, bilinear.
     fn texture_lookup(
         &self,
-        chain: &texture::MipChain,
+        (chain, wrap): (&texture::MipChain, [crate::scene::Wrap; 2]),
         id: u32,
         at: Option<(f32, f32)>,
         lambda: [f32; 3],
@@ -204,7 +240,7 @@ impl<'a> Shader<'a> {
         let uv_along = |o: Vec3, d: Vec3| uv_of(barycentrics(corners, o, d));
         let uv = uv_of(lambda);
         let Some((x, y)) = at else {
-            return chain.sample(uv, Vec2::ZERO, Vec2::ZERO, TextureFilter::Bilinear);
+            return chain.sample(uv, (Vec2::ZERO, Vec2::ZERO), TextureFilter::Bilinear, wrap);
         };
         let qx = (x.floor() as i64 & !1) as f32 + 0.5;
         let qy = (y.floor() as i64 & !1) as f32 + 0.5;
@@ -216,7 +252,7 @@ impl<'a> Shader<'a> {
             ),
             _ => (Vec2::ZERO, Vec2::ZERO),
         };
-        chain.sample(uv, ddx, ddy, self.filter)
+        chain.sample(uv, (ddx, ddy), self.filter, wrap)
     }
 
     /// The unit normal that shades triangle `id` where the ray along `dir`

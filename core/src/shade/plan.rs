@@ -1,7 +1,9 @@
 //! The effect plan: simulate only what the scene calls for. From the scene
 //! alone it decides which secondary rays a render casts — shadow rays for each
 //! light with `shadows = true` (TOML) or from glTF, reflection rays when a
-//! material has `reflectivity > 0` — and the counters report what each cost.
+//! material has `reflectivity > 0`, texture lookups when a material has a
+//! base-colour texture, sorted blending of fragments when a material has
+//! `opacity < 1` — and the counters report what each cost.
 //! A scene that asks for nothing runs nothing: no rays, no time.
 
 use serde::Serialize;
@@ -21,6 +23,9 @@ pub struct EffectPlan {
     pub reflections: bool,
     /// Whether any material has a base-colour texture.
     pub textures: bool,
+    /// Whether any material is see-through (`opacity < 1`): its fragments are
+    /// kept per sample, sorted and blended (A-buffer).
+    pub transparency: bool,
 }
 
 impl EffectPlan {
@@ -38,11 +43,12 @@ impl EffectPlan {
                 .materials
                 .iter()
                 .any(|m| m.base_color_texture.is_some()),
+            transparency: scene.materials.iter().any(|m| m.opacity < 1.0),
         }
     }
 
     pub fn is_empty(&self) -> bool {
-        self.shadow_lights.is_empty() && !self.reflections && !self.textures
+        self.shadow_lights.is_empty() && !self.reflections && !self.textures && !self.transparency
     }
 }
 
@@ -59,6 +65,10 @@ pub struct EffectCounters {
     pub shadow_s: f64,
     pub reflection_rays: u64,
     pub reflection_s: f64,
+    /// Transparent fragments blended into samples, and the time sorting,
+    /// shading and blending them took.
+    pub fragments_blended: u64,
+    pub transparency_s: f64,
 }
 
 impl EffectCounters {
@@ -82,10 +92,12 @@ impl EffectCounters {
         self.texture_s += o.texture_s;
         self.reflection_rays += o.reflection_rays;
         self.reflection_s += o.reflection_s;
+        self.fragments_blended += o.fragments_blended;
+        self.transparency_s += o.transparency_s;
     }
 
     /// The `Stats.effects` entries: textures, one per shadow-casting light,
-    /// reflections, in that order.
+    /// reflections, transparency, in that order.
     pub fn report(&self, plan: &EffectPlan, scene: &Scene) -> Vec<EffectStats> {
         let mut out: Vec<EffectStats> = Vec::new();
         if plan.textures {
@@ -95,6 +107,7 @@ impl EffectCounters {
                 rays: 0,
                 lookups: self.texture_lookups,
                 texel_probes: self.texture_probes,
+                fragments: 0,
                 worker_ms: self.texture_s * 1e3,
             });
         }
@@ -108,6 +121,7 @@ impl EffectCounters {
                 rays,
                 lookups: 0,
                 texel_probes: 0,
+                fragments: 0,
                 worker_ms: 0.0,
             })
             .collect();
@@ -126,7 +140,19 @@ impl EffectCounters {
                 rays: self.reflection_rays,
                 lookups: 0,
                 texel_probes: 0,
+                fragments: 0,
                 worker_ms: self.reflection_s * 1e3,
+            });
+        }
+        if plan.transparency {
+            out.push(EffectStats {
+                effect: "transparency",
+                light: None,
+                rays: 0,
+                lookups: 0,
+                texel_probes: 0,
+                fragments: self.fragments_blended,
+                worker_ms: self.transparency_s * 1e3,
             });
         }
         out
@@ -136,7 +162,7 @@ impl EffectCounters {
 /// One effect that ran, and what it cost.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct EffectStats {
-    /// `shadows` or `reflections`.
+    /// `textures`, `shadows`, `reflections` or `transparency`.
     pub effect: &'static str,
     /// The light a shadow entry belongs to.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -146,6 +172,8 @@ pub struct EffectStats {
     /// Texture lookups (textures only) and the bilinear probes they took.
     pub lookups: u64,
     pub texel_probes: u64,
+    /// Transparent fragments blended (transparency only).
+    pub fragments: u64,
     /// Time the render's workers spent on it, summed over threads (shadow
     /// time is measured for all lights together and shared out by rays).
     pub worker_ms: f64,

@@ -80,14 +80,18 @@ pub fn intersect(
         return None;
     }
     let lambda = [v[0] / total, v[1] / total, v[2] / total];
-    // The hit point's distance along the ray: the plane through the vertices.
+    let t = plane_distance(p, origin, dir)?;
+    (t > t_min && t < t_max).then_some((t, lambda))
+}
+
+/// Where the ray `origin + t·dir` meets the plane through `p`: `t = N·(p_0 − o) / N·d`
+/// with `N = (p_1 − p_0) × (p_2 − p_0)`; `None` when the ray runs along it.
+#[inline]
+pub fn plane_distance(p: &[Vec3; 3], origin: Vec3, dir: Vec3) -> Option<f32> {
     let normal = (p[1] - p[0]).cross(p[2] - p[0]);
     let denom = normal.dot(dir);
-    if denom == 0.0 {
-        return None;
-    }
     let t = normal.dot(p[0] - origin) / denom;
-    (t > t_min && t < t_max).then_some((t, lambda))
+    (denom != 0.0 && t.is_finite()).then_some(t)
 }
 
 /// Queries of one prepared scene.
@@ -101,8 +105,9 @@ impl<'a> Rays<'a> {
         Rays { scene }
     }
 
-    /// The nearest hit along `origin + t·dir` with `t > t_min`, ignoring
-    /// triangle `skip` (the surface the ray leaves). Ties in `t` go to the
+    /// The nearest opaque hit along `origin + t·dir` with `t > t_min`,
+    /// ignoring triangle `skip` (the surface the ray leaves) and see-through
+    /// triangles (a mirror shows opaque surfaces only). Ties in `t` go to the
     /// smaller id, as everywhere.
     pub fn closest(&self, origin: Vec3, dir: Vec3, t_min: f32, skip: u32) -> Option<Hit> {
         let mut best: Option<Hit> = None;
@@ -111,6 +116,7 @@ impl<'a> Rays<'a> {
             let id = scene.slot_triangles[slot as usize];
             let t_max = best.map_or(f32::INFINITY, |h| h.t);
             if id != skip
+                && !scene.is_transparent(id)
                 && let Some((t, lambda)) = intersect(
                     &scene.triangles[id as usize],
                     origin,
@@ -130,17 +136,35 @@ impl<'a> Rays<'a> {
     /// Whether anything lies on `origin + t·dir` for `t` in `(t_min, t_max)`,
     /// ignoring triangle `skip`; stops at the first hit.
     pub fn occluded(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32, skip: u32) -> bool {
-        let mut hit = false;
+        self.transmittance(origin, dir, t_min, t_max, skip) == 0.0
+    }
+
+    /// The share of light that passes along `origin + t·dir` for `t` in
+    /// `(t_min, t_max)`, ignoring triangle `skip`: 0 at the first opaque hit
+    /// (the walk ends there), else the product of `1 − opacity` over the
+    /// see-through triangles met (1 when nothing is met).
+    pub fn transmittance(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32, skip: u32) -> f32 {
+        let mut passed = 1.0f32;
         let scene = self.scene;
         scene.bvh.walk(origin, dir, |slot| {
             let id = scene.slot_triangles[slot as usize];
-            if !hit && id != skip {
-                hit = intersect(&scene.triangles[id as usize], origin, dir, t_min, t_max).is_some();
+            if passed > 0.0
+                && id != skip
+                && intersect(&scene.triangles[id as usize], origin, dir, t_min, t_max).is_some()
+            {
+                passed *= scene
+                    .triangle_opacity
+                    .get(id as usize)
+                    .map_or(0.0, |o| 1.0 - o);
             }
-            // Nothing is nearer than a hit: the walk ends.
-            if hit { f32::NEG_INFINITY } else { t_max }
+            // Nothing passes an opaque hit: the walk ends.
+            if passed > 0.0 {
+                t_max
+            } else {
+                f32::NEG_INFINITY
+            }
         });
-        hit
+        passed
     }
 }
 

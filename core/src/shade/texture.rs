@@ -3,12 +3,13 @@
 //! `trilinear`, and `anisotropic:N` — driven by the screen-space derivatives
 //! of the texture coordinates that a 2×2 pixel quad gives (the `ddx_coarse`
 //! approach of paper §4; the MIT lecture's mip-mapping and anisotropic filtering).
-//! Coordinates wrap (glTF's default `REPEAT`).
+//! Coordinates outside [0, 1] wrap as the texture's sampler says ([`Wrap`]:
+//! repeat, clamp to edge, mirrored repeat).
 
 use glam::{Vec2, Vec4};
 
 use crate::request::FieldError;
-use crate::scene::ImageSource;
+use crate::scene::{ImageSource, Wrap};
 use crate::shade::decode_srgb;
 
 /// How texture lookups are filtered.
@@ -75,32 +76,33 @@ struct Level {
 }
 
 impl Level {
-    /// The texel at integer coordinates, wrapped.
+    /// The texel at integer coordinates, wrapped along u and v.
     #[inline]
-    fn texel(&self, x: i64, y: i64) -> Vec4 {
-        let x = x.rem_euclid(i64::from(self.width)) as usize;
-        let y = y.rem_euclid(i64::from(self.height)) as usize;
+    fn texel(&self, x: i64, y: i64, [wu, wv]: [Wrap; 2]) -> Vec4 {
+        let x = wu.texel(x, self.width);
+        let y = wv.texel(y, self.height);
         self.texels[y * self.width as usize + x]
     }
 
     /// The texel whose area holds `uv`.
     #[inline]
-    fn nearest(&self, uv: Vec2) -> Vec4 {
+    fn nearest(&self, uv: Vec2, wrap: [Wrap; 2]) -> Vec4 {
         let x = (uv.x * self.width as f32).floor() as i64;
         let y = (uv.y * self.height as f32).floor() as i64;
-        self.texel(x, y)
+        self.texel(x, y, wrap)
     }
 
     /// The four texels around `uv` (texel centres at half-integers), weighted.
     #[inline]
-    fn bilinear(&self, uv: Vec2) -> Vec4 {
+    fn bilinear(&self, uv: Vec2, wrap: [Wrap; 2]) -> Vec4 {
         let x = uv.x * self.width as f32 - 0.5;
         let y = uv.y * self.height as f32 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
-        let top = self.texel(x0, y0).lerp(self.texel(x0 + 1, y0), fx);
-        let bottom = self.texel(x0, y0 + 1).lerp(self.texel(x0 + 1, y0 + 1), fx);
+        let texel = |dx, dy| self.texel(x0 + dx, y0 + dy, wrap);
+        let top = texel(0, 0).lerp(texel(1, 0), fx);
+        let bottom = texel(0, 1).lerp(texel(1, 1), fx);
         top.lerp(bottom, fy)
     }
 
@@ -219,18 +221,24 @@ impl MipChain {
     }
 
     /// The filtered colour at `uv`, where `ddx`, `ddy` are how `uv` changes
-    /// from one pixel to the next along x and y; returns it and the number of
-    /// bilinear (or nearest) probes it took.
-    pub fn sample(&self, uv: Vec2, ddx: Vec2, ddy: Vec2, filter: TextureFilter) -> (Vec4, u32) {
+    /// from one pixel to the next along x and y, wrapped by `wrap`; returns
+    /// it and the number of bilinear (or nearest) probes it took.
+    pub fn sample(
+        &self,
+        uv: Vec2,
+        (ddx, ddy): (Vec2, Vec2),
+        filter: TextureFilter,
+        wrap: [Wrap; 2],
+    ) -> (Vec4, u32) {
         let base = &self.levels[0];
         let size = Vec2::new(base.width as f32, base.height as f32);
         // The footprint's axes in texels.
         let (ax, ay) = (ddx * size, ddy * size);
         let (lx, ly) = (ax.length(), ay.length());
         match filter {
-            TextureFilter::Nearest => (base.nearest(uv), 1),
-            TextureFilter::Bilinear => (base.bilinear(uv), 1),
-            TextureFilter::Trilinear => self.trilinear(uv, lx.max(ly)),
+            TextureFilter::Nearest => (base.nearest(uv, wrap), 1),
+            TextureFilter::Bilinear => (base.bilinear(uv, wrap), 1),
+            TextureFilter::Trilinear => self.trilinear(uv, lx.max(ly), wrap),
             TextureFilter::Anisotropic(max) => {
                 // Probes along the major axis, each as wide as the minor one
                 // (or as the major one over `max`, when that is wider).
@@ -249,7 +257,7 @@ impl MipChain {
                 let mut taken = 0;
                 for i in 0..probes {
                     let offset = (i as f32 + 0.5) / probes as f32 - 0.5;
-                    let (c, n) = self.trilinear(uv + major * offset, width);
+                    let (c, n) = self.trilinear(uv + major * offset, width, wrap);
                     sum += c;
                     taken += n;
                 }
@@ -259,18 +267,18 @@ impl MipChain {
     }
 
     /// Trilinear filtering of a footprint `width` texels across.
-    fn trilinear(&self, uv: Vec2, width: f32) -> (Vec4, u32) {
+    fn trilinear(&self, uv: Vec2, width: f32, wrap: [Wrap; 2]) -> (Vec4, u32) {
         let lod = width.max(1.0).log2().min((self.levels.len() - 1) as f32);
         let lo = lod.floor() as usize;
         let hi = (lo + 1).min(self.levels.len() - 1);
         let t = lod - lo as f32;
         if t == 0.0 || lo == hi {
-            return (self.levels[lo].bilinear(uv), 1);
+            return (self.levels[lo].bilinear(uv, wrap), 1);
         }
         (
             self.levels[lo]
-                .bilinear(uv)
-                .lerp(self.levels[hi].bilinear(uv), t),
+                .bilinear(uv, wrap)
+                .lerp(self.levels[hi].bilinear(uv, wrap), t),
             2,
         )
     }
@@ -335,30 +343,43 @@ mod tests {
     fn lookups_wrap_and_filter() {
         let c = checker(4);
         let white = Vec4::ONE;
-        let (d0, d1) = (Vec2::ZERO, Vec2::ZERO);
+        let d = (Vec2::ZERO, Vec2::ZERO);
+        let repeat = [Wrap::Repeat; 2];
+        let nearest = |uv, wrap| c.sample(uv, d, TextureFilter::Nearest, wrap).0;
         // The first texel is white, its right neighbour black; uv wraps.
+        assert_eq!(nearest(Vec2::new(0.1, 0.1), repeat), white);
+        assert_eq!(nearest(Vec2::new(1.1, -0.9), repeat), white);
+        // u = 1.1: repeat is texel 0 (white), clamp the last texel of row 0
+        // (black), mirror texel 3 of the mirrored copy (black); v = -0.9
+        // mirrored is row 3.
         assert_eq!(
-            c.sample(Vec2::new(0.1, 0.1), d0, d1, TextureFilter::Nearest)
-                .0,
-            white
+            nearest(Vec2::new(1.1, 0.1), [Wrap::ClampToEdge; 2]),
+            Vec4::new(0.0, 0.0, 0.0, 1.0)
         );
         assert_eq!(
-            c.sample(Vec2::new(1.1, -0.9), d0, d1, TextureFilter::Nearest)
-                .0,
+            nearest(Vec2::new(1.1, 0.1), [Wrap::MirroredRepeat; 2]),
+            Vec4::new(0.0, 0.0, 0.0, 1.0)
+        );
+        assert_eq!(
+            nearest(Vec2::new(0.1, -0.9), [Wrap::Repeat, Wrap::MirroredRepeat]),
+            Vec4::new(0.0, 0.0, 0.0, 1.0)
+        );
+        assert_eq!(
+            nearest(Vec2::new(-0.1, 0.1), [Wrap::MirroredRepeat; 2]),
             white
         );
         // Halfway between texel centres: the mean.
         let mid = c
-            .sample(Vec2::new(0.25, 0.125), d0, d1, TextureFilter::Bilinear)
+            .sample(Vec2::new(0.25, 0.125), d, TextureFilter::Bilinear, repeat)
             .0;
         assert!((mid.x - 0.5).abs() < 1e-6, "{mid}");
         // A footprint of the whole texture: the 1×1 level's grey.
         let wide = c
             .sample(
                 Vec2::new(0.3, 0.7),
-                Vec2::new(1.0, 0.0),
-                Vec2::new(0.0, 1.0),
+                (Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0)),
                 TextureFilter::Trilinear,
+                repeat,
             )
             .0;
         assert!((wide.x - 0.5).abs() < 1e-6, "{wide}");
@@ -370,16 +391,22 @@ mod tests {
         // Footprint 8 texels along u, 1 along v: 8 probes at level 0.
         let ddx = Vec2::new(8.0 / 64.0, 0.0);
         let ddy = Vec2::new(0.0, 1.0 / 64.0);
+        let repeat = [Wrap::Repeat; 2];
         let (color, probes) = c.sample(
             Vec2::new(0.5, 0.5),
-            ddx,
-            ddy,
+            (ddx, ddy),
             TextureFilter::Anisotropic(16),
+            repeat,
         );
         assert_eq!(probes, 8);
         assert!((color.x - 0.5).abs() < 0.1, "{color}");
         // Capped at N: four probes, each two texels wide (level 1).
-        let (_, capped) = c.sample(Vec2::new(0.5, 0.5), ddx, ddy, TextureFilter::Anisotropic(4));
+        let (_, capped) = c.sample(
+            Vec2::new(0.5, 0.5),
+            (ddx, ddy),
+            TextureFilter::Anisotropic(4),
+            repeat,
+        );
         assert_eq!(capped, 4);
     }
 }
