@@ -90,7 +90,10 @@ pub fn measure_cell(
             Entry::Algorithm(a) => {
                 camera.viewport.serves(a)
                     && cell.precision.serves(a.family())
-                    && (a != AlgorithmId::GpuRaster || cell.aa == AaMode::None)
+                    && (a != AlgorithmId::GpuRaster
+                        || (cell.aa == AaMode::None
+                            // gpu-raster draws opaque surfaces only.
+                            && scene.prepared.triangle_opacity.is_empty()))
             }
             // Peers cast one ray per pixel in their own precision.
             Entry::Peer(_) => cell.aa == AaMode::None && cell.precision == Precision::F32,
