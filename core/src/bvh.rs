@@ -159,7 +159,64 @@ impl SceneBvh {
         );
         visited
     }
+
+    /// [`SceneBvh::walk`] for a packet of up to [`PACKET`] rays (`None` lanes
+    /// are absent): a node is entered when any ray meets it before its own
+    /// culling distance, so every ray reaches every node its single walk would
+    /// (front to back in the first present ray's order). `leaf(slot, cull)`
+    /// is called for each primitive slot of every leaf the packet reaches and
+    /// updates each lane's culling distance in `cull`. Returns the number of
+    /// nodes whose children were tested (once per node, for the packet).
+    #[inline]
+    pub fn walk_packet(
+        &self,
+        rays: &[Option<(Vec3, Vec3)>; PACKET],
+        mut leaf: impl FnMut(u32, &mut [f32; PACKET]),
+    ) -> u64 {
+        let Some(first) = rays.iter().flatten().next() else {
+            return 0;
+        };
+        if self.cwbvh.nodes.is_empty() {
+            return 0;
+        }
+        let slabs = rays.map(|r| r.map(|(o, d)| SlabRay::new(o, d)));
+        // Absent lanes never enter a node.
+        let mut cull = rays.map(|r| {
+            if r.is_some() {
+                f32::INFINITY
+            } else {
+                f32::NEG_INFINITY
+            }
+        });
+        let mut visited = 0u64;
+        let bvh = &self.cwbvh;
+        let mut state = bvh.new_traversal(Vec3A::from(first.1));
+        let mut node: &CwBvhNode;
+        obvhs::traverse!(
+            bvh,
+            node,
+            state,
+            {
+                visited += 1;
+                let boxes = &self.child_boxes[node_index(bvh, node)];
+                let mut mask = 0;
+                for (slab, &tmax) in slabs.iter().zip(&cull) {
+                    if let Some(slab) = slab {
+                        mask |= slab.child_hitmask(node, boxes, tmax, state.oct_inv4);
+                    }
+                }
+                mask
+            },
+            {
+                leaf(state.primitive_id, &mut cull);
+            }
+        );
+        visited
+    }
 }
+
+/// Rays walked together by [`SceneBvh::walk_packet`]: a 2×2 pixel quad.
+pub const PACKET: usize = 4;
 
 /// A ray prepared for slab tests.
 #[derive(Clone, Copy, Debug)]

@@ -12,6 +12,7 @@ use glam::Vec3;
 
 use super::{Pass, TileContext};
 use crate::aa::SamplePattern;
+use crate::bvh::PACKET;
 use crate::camera::View;
 use crate::edge::Coverage;
 use crate::framebuffer::{
@@ -79,7 +80,12 @@ pub(crate) fn render_raycast<'a, T: Coverage + Send + Sync>(
     pass
 }
 
-/// Every stored sample of the band's pixels; returns the BVH nodes visited.
+/// Every stored sample of the band's pixels, cast as packets: the rays of one
+/// sample position through the four pixels of a 2×2 quad walk the BVH together
+/// ([`SceneBvh::walk_packet`](crate::bvh::SceneBvh::walk_packet)), each ray
+/// tested on its own against every triangle the packet reaches, so each finds
+/// exactly the hit its single walk would; the quad is the one texture
+/// derivatives come from. Returns the BVH nodes visited.
 fn cast_band<T: Coverage>(
     scene: &PreparedScene,
     view: &View,
@@ -89,54 +95,71 @@ fn cast_band<T: Coverage>(
     let pattern = tile.pattern;
     let (stored, pixels) = (pattern.stored, tile.pixels);
     let mut nodes = 0;
-    let mut slots = [0u32; 8];
-    for y in tile.y0..tile.y1 {
-        for x in tile.x0..tile.x1 {
-            let i = tile.index(x, y);
+    // Per lane: the BVH slot of each stored sample's triangle (CSAA).
+    let mut slots = [[0u32; 8]; PACKET];
+    for y in (tile.y0..tile.y1).step_by(2) {
+        for x in (tile.x0..tile.x1).step_by(2) {
+            let quad = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)]
+                .map(|(px, py)| (px < tile.x1 && py < tile.y1).then_some((px, py)));
+            let index = quad.map(|p| p.map_or(0, |(px, py)| tile.index(px, py)));
             for (s, &[ox, oy]) in pattern.positions[..stored].iter().enumerate() {
-                let (xs, ys) = (x as f32 + ox, y as f32 + oy);
+                let points = quad.map(|p| p.map(|(px, py)| (px as f32 + ox, py as f32 + oy)));
                 // No ray outside the viewport (the parabolic disc): background.
-                let Some((origin, direction)) = view.ray(xs, ys) else {
-                    continue;
-                };
-                let (mut best_w, mut best_id, mut best_slot) = (f32::INFINITY, BACKGROUND, 0);
-                let (mut evals, mut covered) = (0u32, 0u32);
-                let j = s * pixels + i;
+                let rays = points.map(|p| p.and_then(|(xs, ys)| view.ray(xs, ys)));
+                let mut best = [(f32::INFINITY, BACKGROUND, 0u32); PACKET];
+                let (mut evals, mut covered) = ([0u32; PACKET], [0u32; PACKET]);
                 // See-through triangles leave fragments, as in the rasterizers'
                 // `TileBuffer::write`; the walk still culls beyond the nearest
                 // opaque hit, behind which no fragment shows.
                 let opacity = tile.opacity;
                 let fragments = &mut tile.fragments;
-                nodes += scene.bvh.walk(origin, direction, |k| {
-                    if let Some(tri) = &setups[k as usize] {
-                        evals += 1;
-                        if let Some(w) = tri.sample(xs, ys) {
-                            covered += 1;
-                            let id = scene.slot_triangles[k as usize];
-                            if is_see_through(opacity, id) {
-                                fragments.push(Fragment {
-                                    sample: j as u32,
-                                    w,
-                                    id,
-                                });
-                            } else if wins_depth_test(w, id, best_w, best_id) {
-                                (best_w, best_id, best_slot) = (w, id, k);
-                            }
+                nodes += scene.bvh.walk_packet(&rays, |k, cull| {
+                    let Some(tri) = &setups[k as usize] else {
+                        return;
+                    };
+                    let id = scene.slot_triangles[k as usize];
+                    for l in 0..PACKET {
+                        let (Some(_), Some((xs, ys))) = (rays[l], points[l]) else {
+                            continue;
+                        };
+                        evals[l] += 1;
+                        let Some(w) = tri.sample(xs, ys) else {
+                            continue;
+                        };
+                        covered[l] += 1;
+                        if is_see_through(opacity, id) {
+                            fragments.push(Fragment {
+                                sample: (s * pixels + index[l]) as u32,
+                                w,
+                                id,
+                            });
+                        } else if wins_depth_test(w, id, best[l].0, best[l].1) {
+                            best[l] = (w, id, k);
+                            cull[l] = w * CULL_MARGIN;
                         }
                     }
-                    best_w * CULL_MARGIN
                 });
-                tile.edge_evals[i] += evals;
-                tile.coverage_writes[j] = covered;
-                tile.depth[j] = best_w;
-                tile.triangle_id[j] = best_id;
-                if pattern.has_coverage_only() {
-                    slots[s] = best_slot;
+                for l in 0..PACKET {
+                    if rays[l].is_none() {
+                        continue;
+                    }
+                    let (i, j) = (index[l], s * pixels + index[l]);
+                    tile.edge_evals[i] += evals[l];
+                    tile.coverage_writes[j] = covered[l];
+                    let (w, id, slot) = best[l];
+                    (tile.depth[j], tile.triangle_id[j]) = (w, id);
+                    if pattern.has_coverage_only() {
+                        slots[l][s] = slot;
+                    }
                 }
             }
             if pattern.has_coverage_only() {
-                stored_masks(setups, &slots, tile, (x, y));
-                nodes += lost_coverage(scene, view, setups, tile, (x, y));
+                for (l, p) in quad.into_iter().enumerate() {
+                    if let Some(p) = p {
+                        stored_masks(setups, &slots[l], tile, p);
+                        nodes += lost_coverage(scene, view, setups, tile, p);
+                    }
+                }
             }
         }
     }
