@@ -140,11 +140,10 @@ pub fn clip_triangle(tri: [DVec3; 3], planes: &[ClipPlane]) -> Option<ClipPolygo
     };
     poly.vertices[..3].copy_from_slice(&tri);
     for plane in planes {
-        let src = poly;
-        let n = src.len;
+        let n = poly.len;
         let dist: [f64; MAX_CLIPPED] = std::array::from_fn(|i| {
             if i < n {
-                plane.distance(src.vertices[i])
+                plane.distance(poly.vertices[i])
             } else {
                 0.0
             }
@@ -152,6 +151,8 @@ pub fn clip_triangle(tri: [DVec3; 3], planes: &[ClipPlane]) -> Option<ClipPolygo
         if dist[..n].iter().all(|&d| d >= 0.0) {
             continue;
         }
+        // Copied only when the plane cuts (most triangles are inside every plane).
+        let src = poly;
         poly.len = 0;
         for i in 0..n {
             let j = (i + 1) % n;
