@@ -254,15 +254,20 @@ impl View {
     /// The ray through image point `(x, y)`: origin and direction, scaled so that
     /// `origin + direction · depth` is the point a depth-buffer value names.
     /// `None` where the viewport has no ray (outside the parabolic disc).
-    #[inline]
+    #[inline(always)]
     pub fn ray(&self, x: f32, y: f32) -> Option<(Vec3, Vec3)> {
         match &self.sphere {
+            // Planar views, per shaded sample: inline, in registers.
             None => Some((self.origin(x, y), self.direction(x, y))),
-            Some(map) => {
-                let d = map.direction(f64::from(x), f64::from(y))?;
-                Some((self.eye, self.camera_to_world(d).normalize().as_vec3()))
-            }
+            Some(map) => self.sphere_ray(map, x, y),
         }
+    }
+
+    /// [`View::ray`] of a non-planar viewport.
+    #[inline(never)]
+    fn sphere_ray(&self, map: &SphereMap, x: f32, y: f32) -> Option<(Vec3, Vec3)> {
+        let d = map.direction(f64::from(x), f64::from(y))?;
+        Some((self.eye, self.camera_to_world(d).normalize().as_vec3()))
     }
 
     /// A camera-space vector `(right, up, forward)` in world space.
