@@ -203,8 +203,9 @@ pub fn counters_table(ui: &mut egui::Ui, renders: &[(&str, &Stats)]) {
         });
 }
 
-/// The effects each render ran (shadow rays per light, reflection rays) and
-/// their worker time; nothing when the scene calls for none.
+/// The effects each render ran (texture lookups, shadow rays per light,
+/// reflection rays, blended fragments) and their worker time; nothing when
+/// the scene calls for none.
 pub fn effects_table(ui: &mut egui::Ui, renders: &[(&str, &Stats)]) {
     if renders.iter().all(|(_, s)| s.effects.is_empty()) {
         ui.label("none: the scene calls for no effect");
@@ -221,7 +222,13 @@ pub fn effects_table(ui: &mut egui::Ui, renders: &[(&str, &Stats)]) {
                         None => format!("{label} {}", e.effect),
                     };
                     ui.label(name);
-                    ui.monospace(format!("{} rays", thousands(e.rays)));
+                    // What the effect counts: rays, texture lookups or blended
+                    // fragments (short words: the panel is narrow).
+                    ui.monospace(match e.effect {
+                        "textures" => format!("{} lookups", thousands(e.lookups)),
+                        "transparency" => format!("{} blends", thousands(e.fragments)),
+                        _ => format!("{} rays", thousands(e.rays)),
+                    });
                     ui.monospace(format!("{:.1} ms", e.worker_ms));
                     ui.end_row();
                 }
