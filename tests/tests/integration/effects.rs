@@ -11,6 +11,9 @@ use glam::Vec3;
 
 const SIZE: (u32, u32) = (160, 120);
 
+/// The built-in scenes made to show an effect.
+const EFFECT_SCENES: [&str; 5] = ["shadows", "mirror", "fig8", "checker", "pane"];
+
 /// (effect, light) → rays, from a render's stats.
 fn rays(scene: &PreparedScene, algorithm: AlgorithmId) -> Vec<(String, Option<String>, u64)> {
     let camera = scene.scene.first_camera();
@@ -92,7 +95,7 @@ fn turning_one_lights_shadows_off_removes_exactly_its_rays() {
 
 #[test]
 fn every_algorithm_shades_the_same_image_with_effects() {
-    for name in ["shadows", "mirror", "fig8", "checker", "pane"] {
+    for name in EFFECT_SCENES {
         let scene = prepared(name);
         for camera in scene.scene.all_cameras() {
             let reference = render_with(&scene, AlgorithmId::ThreeDBrute, &camera, SIZE.0, SIZE.1);
@@ -261,21 +264,42 @@ fn trilinear_and_anisotropic_filtering_alias_less_than_nearest() {
     );
 }
 
-#[test]
-fn a_gltf_base_colour_texture_is_decoded_and_mapped() {
-    // A quad with TEXCOORD_0 and an embedded 2×1 PNG: red on the left, green
-    // on the right (glTF's uv origin is the image's top-left corner).
+/// A 2×1 PNG: red on the left, green on the right.
+fn red_green_png() -> Vec<u8> {
     let mut png = Vec::new();
     image::RgbaImage::from_raw(2, 1, vec![255, 0, 0, 255, 0, 255, 0, 255])
         .expect("2×1 texels")
         .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
         .expect("PNG encoding");
-    let positions: [[f32; 3]; 4] = [
-        [-1.0, -1.0, 0.0],
-        [1.0, -1.0, 0.0],
-        [1.0, 1.0, 0.0],
-        [-1.0, 1.0, 0.0],
-    ];
+    png
+}
+
+/// The corners of a 2×2 quad at z = 0, counter-clockwise from the lower left.
+const QUAD: [[f32; 3]; 4] = [
+    [-1.0, -1.0, 0.0],
+    [1.0, -1.0, 0.0],
+    [1.0, 1.0, 0.0],
+    [-1.0, 1.0, 0.0],
+];
+
+/// A camera 3 units in front of [`QUAD`], which then spans pixels ≈ 13.5..50.5 of 64.
+fn quad_camera() -> continuum::Camera {
+    continuum::Camera {
+        name: "front".into(),
+        eye: Vec3::new(0.0, 0.0, 3.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        viewport: continuum::Viewport::Perspective { fov_y_deg: 60.0 },
+        near: None,
+    }
+}
+
+#[test]
+fn a_gltf_base_colour_texture_is_decoded_and_mapped() {
+    // A quad with TEXCOORD_0 and an embedded 2×1 PNG: red on the left, green
+    // on the right (glTF's uv origin is the image's top-left corner).
+    let png = red_green_png();
+    let positions = QUAD;
     let uvs: [[f32; 2]; 4] = [[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]];
     let indices: [u16; 6] = [0, 1, 2, 0, 2, 3];
     let mut bin: Vec<u8> = positions
@@ -326,14 +350,7 @@ fn a_gltf_base_colour_texture_is_decoded_and_mapped() {
             .filter_map(|t| t.as_ref().err())
             .collect::<Vec<_>>()
     );
-    let camera = continuum::Camera {
-        name: "front".into(),
-        eye: Vec3::new(0.0, 0.0, 3.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        viewport: continuum::Viewport::Perspective { fov_y_deg: 60.0 },
-        near: None,
-    };
+    let camera = quad_camera();
     let request = RenderRequest {
         algorithm: AlgorithmId::Raycast,
         oracles: None,
@@ -587,17 +604,8 @@ fn gpu_raster_refuses_see_through_scenes_naming_the_field() {
 fn gltf_uv_sets_sampler_wrap_modes_and_vertex_colours_are_honoured() {
     // A quad whose texture reads TEXCOORD_1 (u from 0 to 2) through a sampler
     // that clamps u; TEXCOORD_0 is all zeros, a trap. COLOR_0 halves red.
-    let mut png = Vec::new();
-    image::RgbaImage::from_raw(2, 1, vec![255, 0, 0, 255, 0, 255, 0, 255])
-        .expect("2×1 texels")
-        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-        .expect("PNG encoding");
-    let positions: [[f32; 3]; 4] = [
-        [-1.0, -1.0, 0.0],
-        [1.0, -1.0, 0.0],
-        [1.0, 1.0, 0.0],
-        [-1.0, 1.0, 0.0],
-    ];
+    let png = red_green_png();
+    let positions = QUAD;
     let uv1: [[f32; 2]; 4] = [[0.0, 1.0], [2.0, 1.0], [2.0, 0.0], [0.0, 0.0]];
     let colors: [[f32; 4]; 4] = [[0.5, 1.0, 1.0, 1.0]; 4];
     let indices: [u16; 6] = [0, 1, 2, 0, 2, 3];
@@ -656,14 +664,7 @@ fn gltf_uv_sets_sampler_wrap_modes_and_vertex_colours_are_honoured() {
         (texture.tex_coord, texture.wrap),
         (1, [Wrap::ClampToEdge, Wrap::Repeat])
     );
-    let camera = continuum::Camera {
-        name: "front".into(),
-        eye: Vec3::new(0.0, 0.0, 3.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        viewport: continuum::Viewport::Perspective { fov_y_deg: 60.0 },
-        near: None,
-    };
+    let camera = quad_camera();
     let render = |scene: &Scene| {
         let request = RenderRequest {
             algorithm: AlgorithmId::ThreeDFull,
@@ -700,7 +701,7 @@ fn the_2d_family_shades_like_the_3d_family_with_effects() {
     // wherever they pick the same triangle and blend the same fragments, the
     // colour is bitwise the same: shading reads the triangle and the ray, not
     // the family's depth.
-    for name in ["shadows", "mirror", "fig8", "checker", "pane"] {
+    for name in EFFECT_SCENES {
         let scene = prepared(name);
         for camera in scene.scene.all_cameras() {
             let three = render_with(&scene, AlgorithmId::ThreeDBrute, &camera, SIZE.0, SIZE.1);
