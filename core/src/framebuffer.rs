@@ -297,12 +297,6 @@ impl<'p> TileBuffer<'p> {
         ((y - self.y0) * (self.x1 - self.x0) + (x - self.x0)) as usize
     }
 
-    /// Whether triangle `id` leaves fragments instead of writing the w-buffer.
-    #[inline(always)]
-    pub fn is_transparent(&self, id: u32) -> bool {
-        is_see_through(self.opacity, id)
-    }
-
     /// A covered sample (index `i` into the sample buffers): count the coverage
     /// write, then — for an opaque triangle — the w-buffer test with depth ties
     /// going to the smaller triangle id; a see-through triangle's sample is
@@ -311,7 +305,7 @@ impl<'p> TileBuffer<'p> {
     #[inline(always)]
     pub fn write(&mut self, i: usize, w: f32, id: u32) -> bool {
         self.coverage_writes[i] += 1;
-        if self.is_transparent(id) {
+        if is_see_through(self.opacity, id) {
             self.fragments.push(Fragment {
                 sample: i as u32,
                 w,

@@ -9,6 +9,7 @@ use rayon::prelude::*;
 
 use crate::bvh::SceneBvh;
 use crate::scene::{Bounds, Scene};
+use crate::shade::plan::EffectPlan;
 use crate::shade::texture::MipChain;
 
 /// A scene ready to render from any camera.
@@ -75,12 +76,10 @@ impl PreparedScene {
         } else {
             bounds.radius().max(1e-6)
         };
-        // Textures only when a material uses one (the effect plan's rule).
-        let textured = scene
-            .materials
-            .iter()
-            .any(|m| m.base_color_texture.is_some());
-        let textures = if textured {
+        // Mip chains and per-triangle opacity only when the effect plan runs
+        // textures and transparency.
+        let plan = EffectPlan::of(&scene);
+        let textures = if plan.textures {
             scene
                 .images
                 .par_iter()
@@ -89,8 +88,7 @@ impl PreparedScene {
         } else {
             Vec::new()
         };
-        // Per-triangle opacity only when a material is see-through.
-        let triangle_opacity = if scene.materials.iter().any(|m| m.opacity < 1.0) {
+        let triangle_opacity = if plan.transparency {
             mesh.material_ids
                 .iter()
                 .map(|&m| scene.materials[m as usize].opacity)

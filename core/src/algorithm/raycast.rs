@@ -118,6 +118,7 @@ fn cast_band<T: Coverage>(
                         return;
                     };
                     let id = scene.slot_triangles[k as usize];
+                    let see_through = is_see_through(opacity, id);
                     for l in 0..PACKET {
                         let (Some(_), Some((xs, ys))) = (rays[l], points[l]) else {
                             continue;
@@ -127,7 +128,7 @@ fn cast_band<T: Coverage>(
                             continue;
                         };
                         covered[l] += 1;
-                        if is_see_through(opacity, id) {
+                        if see_through {
                             fragments.push(Fragment {
                                 sample: (s * pixels + index[l]) as u32,
                                 w,

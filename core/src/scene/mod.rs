@@ -358,28 +358,11 @@ impl Scene {
         Camera::framing(&self.bounds())
     }
 
-    /// The effects this scene calls for, from the scene alone: `textures` when a
-    /// material has a base-colour texture, `shadows` when a light casts them,
-    /// `reflections` for reflective materials, `transparency` for opacity < 1.
+    /// The effects this scene calls for, from the scene alone (the
+    /// [`EffectPlan`](crate::shade::plan::EffectPlan)'s words): `textures`,
+    /// `shadows`, `reflections`, `transparency`.
     pub fn effects(&self) -> Vec<&'static str> {
-        let mut effects = Vec::new();
-        if self
-            .materials
-            .iter()
-            .any(|m| m.base_color_texture.is_some())
-        {
-            effects.push("textures");
-        }
-        if self.lights.iter().any(|l| l.shadows) {
-            effects.push("shadows");
-        }
-        if self.materials.iter().any(|m| m.reflectivity > 0.0) {
-            effects.push("reflections");
-        }
-        if self.materials.iter().any(|m| m.opacity < 1.0) {
-            effects.push("transparency");
-        }
-        effects
+        crate::shade::plan::EffectPlan::of(self).names()
     }
 
     /// Checks the invariants of [`Mesh`] and that material ids are in range.

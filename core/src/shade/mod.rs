@@ -86,8 +86,7 @@ impl<'a> Shader<'a> {
         depth: f32,
         effects: &mut EffectCounters,
     ) -> Vec3 {
-        self.shade_surface(id, Some(at), origin, dir, depth, 0, effects)
-            .0
+        self.shade_fragment(id, at, (origin, dir), depth, effects).0
     }
 
     /// [`Shader::shade`] for a fragment of a see-through triangle: its colour
@@ -102,33 +101,37 @@ impl<'a> Shader<'a> {
         depth: f32,
         effects: &mut EffectCounters,
     ) -> (Vec3, f32) {
-        self.shade_surface(id, Some(at), ray.0, ray.1, depth, 0, effects)
+        // The shaded point from the triangle's plane and the ray alone (not the
+        // family's own depth), so every algorithm that finds the triangle
+        // shades it alike — the 2D family included.
+        let (origin, dir) = ray;
+        let t = plane_distance(&self.scene.triangles[id as usize], origin, dir).unwrap_or(depth);
+        self.shade_surface(id, Some(at), origin, dir, t, 0, effects)
     }
 
     #[allow(
         clippy::too_many_arguments,
         reason = "one recursion step: the sample, its ray, the bounce and the counters"
     )]
+    /// Triangle `id` where the ray `origin + t·dir` meets its plane (at `t`,
+    /// from [`plane_distance`] for primary samples, from the hit for
+    /// reflection rays): colour and opacity.
     fn shade_surface(
         &self,
         id: u32,
         at: Option<(f32, f32)>,
         origin: Vec3,
         dir: Vec3,
-        depth: f32,
+        t: f32,
         bounce: u32,
         effects: &mut EffectCounters,
     ) -> (Vec3, f32) {
-        // The shaded point from the triangle's plane and the ray alone (not the
-        // family's own depth), so every algorithm that finds the triangle
-        // shades it alike — the 2D family included.
-        let t = plane_distance(&self.scene.triangles[id as usize], origin, dir).unwrap_or(depth);
         let point = origin + dir * t;
         let view_dir = dir.normalize_or_zero();
         let scene = &self.scene.scene;
-        let material = &scene.materials[scene.mesh.material_ids[id as usize] as usize];
-        let textured = material.base_color_texture.is_some() && !scene.mesh.uvs.is_empty();
         let mesh = &scene.mesh;
+        let material = &scene.materials[mesh.material_ids[id as usize] as usize];
+        let textured = material.base_color_texture.is_some() && !mesh.uvs.is_empty();
         // The §3.2 barycentrics, once per sample, when normals, texture
         // coordinates or vertex colours are interpolated.
         let lambda = (textured || !mesh.normals.is_empty() || !mesh.colors.is_empty())

@@ -47,6 +47,20 @@ impl EffectPlan {
         }
     }
 
+    /// The effects that run, in report order: `textures`, `shadows`,
+    /// `reflections`, `transparency`.
+    pub fn names(&self) -> Vec<&'static str> {
+        [
+            (self.textures, "textures"),
+            (!self.shadow_lights.is_empty(), "shadows"),
+            (self.reflections, "reflections"),
+            (self.transparency, "transparency"),
+        ]
+        .into_iter()
+        .filter_map(|(runs, name)| runs.then_some(name))
+        .collect()
+    }
+
     pub fn is_empty(&self) -> bool {
         self.shadow_lights.is_empty() && !self.reflections && !self.textures && !self.transparency
     }
