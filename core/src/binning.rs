@@ -9,6 +9,7 @@
 use crate::algorithm::PixelRect;
 use crate::edge::{BlockTest, Coverage};
 use crate::framebuffer::{SCRATCH_PIXELS, TileBuffer};
+use crate::simd::{self, Lanes, first_lanes};
 use crate::stats::RasterCounters;
 
 /// How samples are enumerated inside a triangle's box.
@@ -104,12 +105,23 @@ fn early_z_rejects<T: Coverage>(
     false
 }
 
-/// Tests every sample of `r` (per-sample coverage, the leaf of every strategy);
-/// returns how many coverage samples the triangle covers.
-#[inline]
-fn test_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRect) -> u32 {
+simd::dispatch! {
+    /// Tests every sample of `r` (per-sample coverage, the leaf of every strategy);
+    /// returns how many coverage samples the triangle covers.
+    fn test_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRect) -> u32
+        => test_samples_on
+}
+
+/// [`test_samples`] on lanes `L`.
+#[inline(always)]
+fn test_samples_on<L: Lanes, T: Coverage>(
+    tile: &mut TileBuffer,
+    tri: &T,
+    id: u32,
+    r: PixelRect,
+) -> u32 {
     if tile.pattern.coverage() > 1 {
-        return sample_pattern(tile, tri, id, r, Samples::Test);
+        return sample_pattern::<L, T>(tile, tri, id, r, Samples::Test);
     }
     // One sample per pixel: runs along rows (which curved edges may evaluate
     // incrementally, §3.5 eq. 3).
@@ -120,7 +132,7 @@ fn test_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRe
         for count in &mut tile.edge_evals[i..i + n as usize] {
             *count += 1;
         }
-        tri.sample_run(r.x0 as f32 + 0.5, y as f32 + 0.5, n, |k, w| {
+        tri.sample_run::<L>(r.x0 as f32 + 0.5, y as f32 + 0.5, n, |k, w| {
             covered += 1;
             tile.write(i + k as usize, w, id);
         });
@@ -128,11 +140,22 @@ fn test_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRe
     covered
 }
 
-/// Writes every sample of `r`, known to be inside the edges: only depth is
-/// computed (with its `near` test). Returns the number of samples written.
-#[inline]
-fn fill_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRect) -> u32 {
-    sample_pattern(tile, tri, id, r, Samples::Inside)
+simd::dispatch! {
+    /// Writes every sample of `r`, known to be inside the edges: only depth is
+    /// computed (with its `near` test). Returns the number of samples written.
+    fn fill_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRect) -> u32
+        => fill_samples_on
+}
+
+/// [`fill_samples`] on lanes `L`.
+#[inline(always)]
+fn fill_samples_on<L: Lanes, T: Coverage>(
+    tile: &mut TileBuffer,
+    tri: &T,
+    id: u32,
+    r: PixelRect,
+) -> u32 {
+    sample_pattern::<L, T>(tile, tri, id, r, Samples::Inside)
 }
 
 /// What [`sample_pattern`] evaluates per sample.
@@ -150,7 +173,8 @@ enum Samples {
 /// stored samples go through the depth test; under CSAA a stored sample that
 /// wins keeps the triangle's mask over all positions of its pixel (coverage-only
 /// positions are decided by [`Coverage::covers8`], without depth).
-fn sample_pattern<T: Coverage>(
+#[inline(always)]
+fn sample_pattern<L: Lanes, T: Coverage>(
     tile: &mut TileBuffer,
     tri: &T,
     id: u32,
@@ -203,12 +227,12 @@ fn sample_pattern<T: Coverage>(
                     (0, [0.0; 8])
                 } else {
                     match how {
-                        Samples::Test => tri.sample_points8(xs, ys),
-                        Samples::Inside => tri.depth_inside8(xs, ys),
+                        Samples::Test => tri.sample_points8::<L>(xs, ys, first_lanes(lanes)),
+                        Samples::Inside => tri.depth_inside8::<L>(xs, ys),
                     }
                 };
                 if coverage_only != 0 {
-                    mask = (mask & !coverage_only) | (tri.covers8(xs, ys) & coverage_only);
+                    mask = (mask & !coverage_only) | (tri.covers8::<L>(xs, ys) & coverage_only);
                 }
                 let mut mask = u32::from(mask) & ((1 << lanes) - 1);
                 covered += mask.count_ones();

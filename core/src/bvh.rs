@@ -15,7 +15,8 @@ use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::node::{CwBvhNode, extract_byte64};
-use wide::f32x8;
+
+use crate::simd::{Lanes, Portable};
 
 /// Relative padding of every box, beyond CWBVH quantisation and rounding.
 pub const BOX_PAD: f32 = 1.0 / (1 << 18) as f32;
@@ -146,7 +147,7 @@ impl SceneBvh {
             state,
             {
                 visited += 1;
-                ray.child_hitmask(
+                ray.child_hitmask::<Portable>(
                     node,
                     &self.child_boxes[node_index(bvh, node)],
                     tmax,
@@ -166,9 +167,11 @@ impl SceneBvh {
     /// (front to back in the first present ray's order). `leaf(slot, cull)`
     /// is called for each primitive slot of every leaf the packet reaches and
     /// updates each lane's culling distance in `cull`. Returns the number of
-    /// nodes whose children were tested (once per node, for the packet).
-    #[inline]
-    pub fn walk_packet(
+    /// nodes whose children were tested (once per node, for the packet). The
+    /// slab tests run on lanes `L` (the caller's instruction set, see
+    /// [`crate::simd`]; inlined into it).
+    #[inline(always)]
+    pub fn walk_packet<L: Lanes>(
         &self,
         rays: &[Option<(Vec3, Vec3)>; PACKET],
         mut leaf: impl FnMut(u32, &mut [f32; PACKET]),
@@ -202,7 +205,7 @@ impl SceneBvh {
                 let mut mask = 0;
                 for (slab, &tmax) in slabs.iter().zip(&cull) {
                     if let Some(slab) = slab {
-                        mask |= slab.child_hitmask(node, boxes, tmax, state.oct_inv4);
+                        mask |= slab.child_hitmask::<L>(node, boxes, tmax, state.oct_inv4);
                     }
                 }
                 mask
@@ -280,19 +283,25 @@ impl SlabRay {
     /// obvhs's hit mask for the children of `node` (boxes `boxes`) this ray meets
     /// before `tmax`: eight slab tests side by side.
     #[inline(always)]
-    fn child_hitmask(&self, node: &CwBvhNode, boxes: &ChildBoxes, tmax: f32, oct_inv4: u32) -> u32 {
+    fn child_hitmask<L: Lanes>(
+        &self,
+        node: &CwBvhNode,
+        boxes: &ChildBoxes,
+        tmax: f32,
+        oct_inv4: u32,
+    ) -> u32 {
         let axis = |a: usize| {
-            let inv = f32x8::splat(self.inv[a]);
-            let ta = (f32x8::from(boxes.lo[a]) - f32x8::splat(self.origin_lo[a])) * inv;
-            let tb = (f32x8::from(boxes.hi[a]) - f32x8::splat(self.origin_hi[a])) * inv;
-            (ta.fast_min(tb), ta.fast_max(tb))
+            let inv = L::splat(self.inv[a]);
+            let ta = (L::from_array(boxes.lo[a]) - L::splat(self.origin_lo[a])) * inv;
+            let tb = (L::from_array(boxes.hi[a]) - L::splat(self.origin_hi[a])) * inv;
+            (ta.min(tb), ta.max(tb))
         };
         let (nx, fx) = axis(0);
         let (ny, fy) = axis(1);
         let (nz, fz) = axis(2);
-        let near = nx.fast_max(ny).fast_max(nz.fast_max(f32x8::ZERO));
-        let far = fx.fast_min(fy).fast_min(fz.fast_min(f32x8::splat(tmax)));
-        let mut hits = near.simd_le(far).to_bitmask();
+        let near = nx.max(ny).max(nz.max(L::splat(0.0)));
+        let far = fx.min(fy).min(fz.min(L::splat(tmax)));
+        let mut hits = u32::from(near.le(far));
         if hits == 0 {
             return 0;
         }

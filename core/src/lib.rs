@@ -34,6 +34,7 @@ pub mod render;
 pub mod request;
 pub mod scene;
 pub mod shade;
+pub mod simd;
 pub mod stats;
 pub mod traversal;
 pub mod viewport;

@@ -4,9 +4,14 @@ use std::path::PathBuf;
 use std::process::{Command, Output};
 
 fn continuum(args: &[&str]) -> Output {
+    continuum_with(args, &[])
+}
+
+fn continuum_with(args: &[&str], env: &[(&str, &str)]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_continuum"))
         .args(args)
         .env("CONTINUUM_SCENES", scenes())
+        .envs(env.iter().copied())
         .output()
         .expect("run continuum")
 }
@@ -77,6 +82,64 @@ fn render_json_has_the_documented_keys() {
             hex.len() == 16 && hex.chars().all(|c| c.is_ascii_hexdigit()),
             "{hex}"
         );
+    }
+}
+
+/// The AVX2 coverage kernels (this machine's) and the portable ones
+/// (`CONTINUUM_SIMD=portable`) give bitwise the same buffers and the same
+/// counts, for the rasterizers, the frustum traversal and the ray caster, with
+/// and without anti-aliasing, effects included.
+#[test]
+fn the_avx2_and_portable_kernels_render_the_same_buffers() {
+    #[cfg(target_arch = "x86_64")]
+    assert!(
+        continuum::simd::cpu_has_avx2(),
+        "this test compares the AVX2 kernels with the portable ones, and this CPU has no AVX2"
+    );
+    let render = |scene: &str, algorithm: &str, aa: &str, simd: &str| {
+        let args = [
+            "render",
+            "--scene",
+            scene,
+            "--algorithm",
+            algorithm,
+            "--aa",
+            aa,
+            "--size",
+            "96x72",
+            "--json",
+        ];
+        let out = continuum_with(&args, &[("CONTINUUM_SIMD", simd)]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let doc: serde_json::Value =
+            serde_json::from_slice(&out.stdout).expect("one JSON document");
+        let counts = [
+            "edge_evaluations",
+            "triangle_setups",
+            "bvh_nodes_visited",
+            "coverage_histogram",
+        ]
+        .map(|k| doc["stats"][k].clone());
+        (doc["hashes"].clone(), counts)
+    };
+    for scene in ["bunny", "pane"] {
+        for algorithm in [
+            "2dr-homogeneous",
+            "3dr-brute",
+            "3dr-bin",
+            "3dr-full",
+            "raycast",
+        ] {
+            for aa in ["none", "csaa:8x4"] {
+                let avx2 = render(scene, algorithm, aa, "avx2");
+                let portable = render(scene, algorithm, aa, "portable");
+                assert_eq!(avx2, portable, "{scene} {algorithm} {aa}");
+            }
+        }
     }
 }
 

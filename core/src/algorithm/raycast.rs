@@ -19,6 +19,7 @@ use crate::framebuffer::{
     BACKGROUND, Fragment, Framebuffer, TileBuffer, is_see_through, wins_depth_test,
 };
 use crate::prepared::PreparedScene;
+use crate::simd::{self, Lanes};
 use crate::stats::Stats;
 
 /// Nodes are culled only when entered beyond the best hit's `w` times this: the
@@ -80,13 +81,24 @@ pub(crate) fn render_raycast<'a, T: Coverage + Send + Sync>(
     pass
 }
 
+simd::dispatch! {
+    /// [`cast_band_on`] on the lanes of this CPU.
+    fn cast_band<T: Coverage>(
+        scene: &PreparedScene,
+        view: &View,
+        setups: &[Option<T>],
+        tile: &mut TileBuffer,
+    ) -> u64 => cast_band_on
+}
+
 /// Every stored sample of the band's pixels, cast as packets: the rays of one
 /// sample position through the four pixels of a 2×2 quad walk the BVH together
 /// ([`SceneBvh::walk_packet`](crate::bvh::SceneBvh::walk_packet)), each ray
 /// tested on its own against every triangle the packet reaches, so each finds
 /// exactly the hit its single walk would; the quad is the one texture
 /// derivatives come from. Returns the BVH nodes visited.
-fn cast_band<T: Coverage>(
+#[inline(always)]
+fn cast_band_on<L: Lanes, T: Coverage>(
     scene: &PreparedScene,
     view: &View,
     setups: &[Option<T>],
@@ -106,6 +118,14 @@ fn cast_band<T: Coverage>(
                 let points = quad.map(|p| p.map(|(px, py)| (px as f32 + ox, py as f32 + oy)));
                 // No ray outside the viewport (the parabolic disc): background.
                 let rays = points.map(|p| p.and_then(|(xs, ys)| view.ray(xs, ys)));
+                // The packet's samples as the first lanes of one 8-lane test.
+                let (mut xs, mut ys, mut present) = ([0.0; 8], [0.0; 8], 0u8);
+                for (l, p) in points.iter().enumerate() {
+                    if let (Some(_), Some((px, py))) = (rays[l], *p) {
+                        (xs[l], ys[l]) = (px, py);
+                        present |= 1 << l;
+                    }
+                }
                 let mut best = [(f32::INFINITY, BACKGROUND, 0u32); PACKET];
                 let (mut evals, mut covered) = ([0u32; PACKET], [0u32; PACKET]);
                 // See-through triangles leave fragments, as in the rasterizers'
@@ -113,20 +133,20 @@ fn cast_band<T: Coverage>(
                 // opaque hit, behind which no fragment shows.
                 let opacity = tile.opacity;
                 let fragments = &mut tile.fragments;
-                nodes += scene.bvh.walk_packet(&rays, |k, cull| {
+                nodes += scene.bvh.walk_packet::<L>(&rays, |k, cull| {
                     let Some(tri) = &setups[k as usize] else {
                         return;
                     };
                     let id = scene.slot_triangles[k as usize];
                     let see_through = is_see_through(opacity, id);
-                    for l in 0..PACKET {
-                        let (Some(_), Some((xs, ys))) = (rays[l], points[l]) else {
-                            continue;
-                        };
-                        evals[l] += 1;
-                        let Some(w) = tri.sample(xs, ys) else {
-                            continue;
-                        };
+                    let (mut hits, depth) = tri.sample_points8::<L>(xs, ys, present);
+                    for (l, e) in evals.iter_mut().enumerate() {
+                        *e += u32::from(present >> l & 1);
+                    }
+                    while hits != 0 {
+                        let l = hits.trailing_zeros() as usize;
+                        hits &= hits - 1;
+                        let w = depth[l];
                         covered[l] += 1;
                         if see_through {
                             fragments.push(Fragment {
@@ -157,8 +177,8 @@ fn cast_band<T: Coverage>(
             if pattern.has_coverage_only() {
                 for (l, p) in quad.into_iter().enumerate() {
                     if let Some(p) = p {
-                        stored_masks(setups, &slots[l], tile, p);
-                        nodes += lost_coverage(scene, view, setups, tile, p);
+                        stored_masks::<L, T>(setups, &slots[l], tile, p);
+                        nodes += lost_coverage::<L, T>(scene, view, setups, tile, p);
                     }
                 }
             }
@@ -170,7 +190,8 @@ fn cast_band<T: Coverage>(
 /// CSAA: the coverage mask of each triangle the stored rays of pixel `(x, y)`
 /// found (`slots[s]`: the BVH slot of stored sample `s`'s triangle), computed
 /// once per triangle.
-fn stored_masks<T: Coverage>(
+#[inline(always)]
+fn stored_masks<L: Lanes, T: Coverage>(
     setups: &[Option<T>],
     slots: &[u32; 8],
     tile: &mut TileBuffer,
@@ -191,7 +212,7 @@ fn stored_masks<T: Coverage>(
                     continue;
                 };
                 tile.edge_evals[i] += pattern.coverage() as u32;
-                coverage_mask(tri, pattern, x, y)
+                coverage_mask::<L, T>(tri, pattern, x, y)
             }
         };
         tile.masks[s * pixels + i] = mask;
@@ -201,7 +222,8 @@ fn stored_masks<T: Coverage>(
 /// The coverage mask of `tri` over pixel `(x, y)` as the rasterizers compute it:
 /// [`Coverage::sample`] at stored positions, [`Coverage::covers8`] at
 /// coverage-only ones.
-fn coverage_mask<T: Coverage>(tri: &T, pattern: &SamplePattern, x: u32, y: u32) -> u32 {
+#[inline(always)]
+fn coverage_mask<L: Lanes, T: Coverage>(tri: &T, pattern: &SamplePattern, x: u32, y: u32) -> u32 {
     let mut mask = 0;
     for (g, group) in pattern.positions.chunks(8).enumerate() {
         let (mut xs, mut ys) = ([0.0; 8], [0.0; 8]);
@@ -210,7 +232,7 @@ fn coverage_mask<T: Coverage>(tri: &T, pattern: &SamplePattern, x: u32, y: u32) 
             xs[l] = x as f32 + ox;
             ys[l] = y as f32 + oy;
         }
-        let covers = tri.covers8(xs, ys);
+        let covers = tri.covers8::<L>(xs, ys);
         for l in 0..group.len() {
             let c = g * 8 + l;
             let bit = if c < pattern.stored {
@@ -229,7 +251,8 @@ fn coverage_mask<T: Coverage>(tri: &T, pattern: &SamplePattern, x: u32, y: u32) 
 /// covered by some other triangle (the rasterizers' `covered_any`, at the
 /// positions the resolve reads it). One any-hit ray per such position; returns
 /// the BVH nodes visited.
-fn lost_coverage<T: Coverage>(
+#[inline(always)]
+fn lost_coverage<L: Lanes, T: Coverage>(
     scene: &PreparedScene,
     view: &View,
     setups: &[Option<T>],
@@ -257,7 +280,7 @@ fn lost_coverage<T: Coverage>(
         nodes += scene
             .bvh
             .walk(origin, direction, |k| match &setups[k as usize] {
-                Some(tri) if tri.covers8([xs; 8], [ys; 8]) & 1 == 1 => {
+                Some(tri) if tri.covers8::<L>([xs; 8], [ys; 8]) & 1 == 1 => {
                     covered |= 1 << c;
                     // Found: cull everything left.
                     f32::NEG_INFINITY

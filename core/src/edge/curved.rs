@@ -15,6 +15,7 @@ use glam::DVec3;
 
 use super::{BlockTest, Coverage};
 use crate::camera::{SphereMap, View};
+use crate::simd::Lanes;
 
 /// A triangle set up against a non-planar viewport.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -264,7 +265,7 @@ impl Coverage for CurvedTriangle {
         }
     }
 
-    fn sample_run(&self, x0: f32, y: f32, n: u32, mut hit: impl FnMut(u32, f32)) {
+    fn sample_run<L: Lanes>(&self, x0: f32, y: f32, n: u32, mut hit: impl FnMut(u32, f32)) {
         match self.map {
             SphereMap::Parabolic { cx, cy, radius } if self.incremental => {
                 self.sample_run_incremental((cx, cy, radius), x0, y, n, hit);

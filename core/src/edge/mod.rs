@@ -27,6 +27,8 @@ pub use edge3d::Triangle3D;
 pub use edge3d_f64::Triangle3D64;
 pub use homogeneous::setup_homogeneous;
 
+use crate::simd::{Lanes, first_lanes};
+
 /// The tie rule of paper §3.4 (Direct3D's top-left rule written with derivatives):
 /// a sample on an edge (`E = 0`) belongs to the triangle whose edge function grows
 /// to the right (`∂E/∂x > 0`), or, for a horizontal edge, downwards
@@ -62,21 +64,23 @@ pub trait Coverage {
     /// Coverage and depth of the sample at `(x, y)`.
     fn sample(&self, x: f32, y: f32) -> Option<f32>;
 
-    /// Coverage and depth of eight samples in a row, at `x0, x0 + 1, …, x0 + 7`:
-    /// a bit mask of the covered ones and their depths. Bit for bit what
-    /// [`Coverage::sample`] gives for each (implementations that vectorise it
-    /// must round alike: no fused multiply-add, the same operation order).
+    /// Coverage and depth of eight samples in a row, at `x0, x0 + 1, …, x0 + 7`,
+    /// of which the lanes in `active` count: a bit mask of the covered ones
+    /// (within `active`) and their depths. Bit for bit what [`Coverage::sample`]
+    /// gives for each, on either instruction set `L` (implementations that
+    /// vectorise it must round alike: no fused multiply-add, the same
+    /// operation order).
     #[inline(always)]
-    fn sample8(&self, x0: f32, y: f32) -> (u8, [f32; 8]) {
-        lanes8(|k| self.sample(x0 + k as f32, y))
+    fn sample8<L: Lanes>(&self, x0: f32, y: f32, active: u8) -> (u8, [f32; 8]) {
+        lanes8(active, |k| self.sample(x0 + k as f32, y))
     }
 
     /// Coverage and depth of eight samples at any points `(x[k], y[k])` (the
-    /// samples of anti-aliasing patterns): the same decisions as
-    /// [`Coverage::sample`] per lane.
+    /// samples of anti-aliasing patterns, the rays of a packet), of which the
+    /// lanes in `active` count: the same decisions as [`Coverage::sample`] per lane.
     #[inline(always)]
-    fn sample_points8(&self, x: [f32; 8], y: [f32; 8]) -> (u8, [f32; 8]) {
-        lanes8(|k| self.sample(x[k], y[k]))
+    fn sample_points8<L: Lanes>(&self, x: [f32; 8], y: [f32; 8], active: u8) -> (u8, [f32; 8]) {
+        lanes8(active, |k| self.sample(x[k], y[k]))
     }
 
     /// Does the triangle cover each of eight points (CSAA's coverage-only
@@ -84,35 +88,29 @@ pub trait Coverage {
     /// edges with the tie rule, in front of the eye and not nearer than `near`.
     /// Every algorithm decides coverage-only positions with this one function.
     #[inline(always)]
-    fn covers8(&self, x: [f32; 8], y: [f32; 8]) -> u8 {
-        self.sample_points8(x, y).0
+    fn covers8<L: Lanes>(&self, x: [f32; 8], y: [f32; 8]) -> u8 {
+        self.sample_points8::<L>(x, y, 0xff).0
     }
 
     /// [`Coverage::depth_inside`] for eight points of a block found inside.
     #[inline(always)]
-    fn depth_inside8(&self, x: [f32; 8], y: [f32; 8]) -> (u8, [f32; 8]) {
-        lanes8(|k| self.depth_inside(x[k], y[k]))
+    fn depth_inside8<L: Lanes>(&self, x: [f32; 8], y: [f32; 8]) -> (u8, [f32; 8]) {
+        lanes8(0xff, |k| self.depth_inside(x[k], y[k]))
     }
 
     /// Coverage of the `n` samples `(x0 + k, y)`, `k < n`: calls `hit(k, w)` for
     /// each covered one. The same decisions as [`Coverage::sample`] per sample.
     #[inline(always)]
-    fn sample_run(&self, x0: f32, y: f32, n: u32, mut hit: impl FnMut(u32, f32)) {
-        let mut k = 0;
-        // Eight samples at a time, then the rest one by one.
-        while k + 8 <= n {
-            let (mask, depth) = self.sample8(x0 + k as f32, y);
+    fn sample_run<L: Lanes>(&self, x0: f32, y: f32, n: u32, mut hit: impl FnMut(u32, f32)) {
+        // Eight samples at a time, the last group with only its first lanes.
+        for k in (0..n).step_by(8) {
+            let active = first_lanes((n - k) as usize);
+            let (mask, depth) = self.sample8::<L>(x0 + k as f32, y, active);
             let mut covered = mask;
             while covered != 0 {
                 let b = covered.trailing_zeros();
                 covered &= covered - 1;
                 hit(k + b, depth[b as usize]);
-            }
-            k += 8;
-        }
-        for k in k..n {
-            if let Some(w) = self.sample(x0 + k as f32, y) {
-                hit(k, w);
             }
         }
     }
@@ -129,13 +127,16 @@ pub trait Coverage {
     fn min_depth(&self) -> f32;
 }
 
-/// Eight scalar decisions as one lane mask and their depths (the default of
-/// the 8-sample methods).
+/// The scalar decisions of the `active` lanes as one lane mask and their
+/// depths (the default of the 8-sample methods).
 #[inline(always)]
-fn lanes8(sample: impl Fn(usize) -> Option<f32>) -> (u8, [f32; 8]) {
+fn lanes8(active: u8, sample: impl Fn(usize) -> Option<f32>) -> (u8, [f32; 8]) {
     let mut mask = 0;
     let mut depth = [0.0; 8];
     for (k, d) in depth.iter_mut().enumerate() {
+        if active >> k & 1 == 0 {
+            continue;
+        }
         if let Some(w) = sample(k) {
             mask |= 1 << k;
             *d = w;

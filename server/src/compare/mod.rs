@@ -456,7 +456,7 @@ fn merge(args: &MergeArgs) -> Result<(), CliError> {
 }
 
 /// The machine a run measured on: CPU, cores, threads, OS, the GPU adapter
-/// (when built with it and one opens) and continuum's version.
+/// (when built with it and one opens), the SIMD kernels and continuum's version.
 fn machine(threads: usize) -> Value {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
@@ -475,6 +475,11 @@ fn machine(threads: usize) -> Value {
         "continuum_version": env!("CARGO_PKG_VERSION"),
         "gpu": gpu_adapter(),
         "lp_num_threads": std::env::var("LP_NUM_THREADS").ok(),
+        // The coverage kernels' instruction set (`CONTINUUM_SIMD=portable` forces the portable one).
+        "simd": match continuum::simd::isa() {
+            continuum::simd::Isa::Avx2 => "avx2",
+            continuum::simd::Isa::Portable => "portable",
+        },
     })
 }
 

@@ -1,0 +1,266 @@
+//! Eight f32 lanes for the per-sample loops, in the instruction set the CPU has.
+//!
+//! The coverage kernels ([`crate::edge::Coverage`]'s 8-lane methods) are
+//! written once, generic over [`Lanes`], and compiled twice: on [`Portable`]
+//! (`wide::f32x8`: two SSE halves on x86-64, whatever the target has
+//! elsewhere) and on [`Avx2`] (one 256-bit register). Which one runs is
+//! decided at run time, once per kernel call, by [`avx2`]: the loops that call
+//! the kernels come in a portable form and an `#[target_feature(enable =
+//! "avx2")]` form. Both perform the same IEEE operations in the same order
+//! with no fused multiply-add (AVX2 does not include FMA, and nothing here asks
+//! for it), so every lane rounds exactly as the scalar [`Coverage::sample`]
+//! does, on either path.
+//!
+//! [`Coverage::sample`]: crate::edge::Coverage::sample
+
+use std::ops::{Add, Div, Mul, Sub};
+use std::sync::OnceLock;
+
+/// The portable eight lanes.
+pub type Portable = wide::f32x8;
+
+/// Eight f32 lanes: arithmetic, x86 `minps`/`maxps` and comparisons to lane
+/// bit masks (bit `l` for lane `l`). Sealed: only this crate builds lanes.
+pub trait Lanes:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + sealed::Ops
+{
+}
+
+impl<L> Lanes for L where
+    L: Copy + Add<Output = L> + Sub<Output = L> + Mul<Output = L> + Div<Output = L> + sealed::Ops
+{
+}
+
+mod sealed {
+    /// The lane operations beyond arithmetic. `max`/`min` are x86's `maxps`/
+    /// `minps`: `self > o ? self : o` (the second operand when either is NaN),
+    /// on every path.
+    pub trait Ops: Sized {
+        fn splat(v: f32) -> Self;
+        fn from_array(v: [f32; 8]) -> Self;
+        fn to_array(self) -> [f32; 8];
+        fn max(self, o: Self) -> Self;
+        fn min(self, o: Self) -> Self;
+        fn gt(self, o: Self) -> u8;
+        fn lt(self, o: Self) -> u8;
+        fn ge(self, o: Self) -> u8;
+        fn le(self, o: Self) -> u8;
+    }
+}
+
+impl sealed::Ops for Portable {
+    #[inline(always)]
+    fn splat(v: f32) -> Self {
+        wide::f32x8::splat(v)
+    }
+    #[inline(always)]
+    fn from_array(v: [f32; 8]) -> Self {
+        wide::f32x8::from(v)
+    }
+    #[inline(always)]
+    fn to_array(self) -> [f32; 8] {
+        wide::f32x8::to_array(self)
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        self.fast_max(o)
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        self.fast_min(o)
+    }
+    #[inline(always)]
+    fn gt(self, o: Self) -> u8 {
+        self.simd_gt(o).to_bitmask() as u8
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> u8 {
+        self.simd_lt(o).to_bitmask() as u8
+    }
+    #[inline(always)]
+    fn ge(self, o: Self) -> u8 {
+        self.simd_ge(o).to_bitmask() as u8
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> u8 {
+        self.simd_le(o).to_bitmask() as u8
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+pub use avx2_lanes::Avx2;
+
+#[cfg(target_arch = "x86_64")]
+mod avx2_lanes {
+    use std::arch::x86_64::*;
+    use std::ops::{Add, Div, Mul, Sub};
+
+    /// Eight lanes in one AVX register. No value of this type exists except
+    /// inside a function compiled with `#[target_feature(enable = "avx2")]`
+    /// that was entered after [`super::avx2`] said the CPU has it: the only
+    /// constructors are the sealed [`super::sealed::Ops`] methods, called by
+    /// this crate's kernels on that path alone.
+    #[derive(Clone, Copy, Debug)]
+    pub struct Avx2(__m256);
+
+    /// One AVX instruction on lanes.
+    macro_rules! avx {
+        ($e:expr) => {
+            // SAFETY: an `Avx2` value is only ever made and used on the AVX2
+            // path (see the type's documentation), so the CPU supports the
+            // instruction; the intrinsics take and return registers only.
+            unsafe { $e }
+        };
+    }
+
+    impl Add for Avx2 {
+        type Output = Avx2;
+        #[inline(always)]
+        fn add(self, o: Avx2) -> Avx2 {
+            Avx2(avx!(_mm256_add_ps(self.0, o.0)))
+        }
+    }
+    impl Sub for Avx2 {
+        type Output = Avx2;
+        #[inline(always)]
+        fn sub(self, o: Avx2) -> Avx2 {
+            Avx2(avx!(_mm256_sub_ps(self.0, o.0)))
+        }
+    }
+    impl Mul for Avx2 {
+        type Output = Avx2;
+        #[inline(always)]
+        fn mul(self, o: Avx2) -> Avx2 {
+            Avx2(avx!(_mm256_mul_ps(self.0, o.0)))
+        }
+    }
+    impl Div for Avx2 {
+        type Output = Avx2;
+        #[inline(always)]
+        fn div(self, o: Avx2) -> Avx2 {
+            Avx2(avx!(_mm256_div_ps(self.0, o.0)))
+        }
+    }
+
+    impl super::sealed::Ops for Avx2 {
+        #[inline(always)]
+        fn splat(v: f32) -> Self {
+            Avx2(avx!(_mm256_set1_ps(v)))
+        }
+        #[inline(always)]
+        fn from_array(v: [f32; 8]) -> Self {
+            // SAFETY (beyond `avx!`'s): `v` holds eight f32, the unaligned load reads exactly them.
+            Avx2(avx!(_mm256_loadu_ps(v.as_ptr())))
+        }
+        #[inline(always)]
+        fn to_array(self) -> [f32; 8] {
+            let mut out = [0.0; 8];
+            // SAFETY (beyond `avx!`'s): `out` has room for exactly eight f32.
+            avx!(_mm256_storeu_ps(out.as_mut_ptr(), self.0));
+            out
+        }
+        #[inline(always)]
+        fn max(self, o: Self) -> Self {
+            Avx2(avx!(_mm256_max_ps(self.0, o.0)))
+        }
+        #[inline(always)]
+        fn min(self, o: Self) -> Self {
+            Avx2(avx!(_mm256_min_ps(self.0, o.0)))
+        }
+        #[inline(always)]
+        fn gt(self, o: Self) -> u8 {
+            avx!(_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(self.0, o.0))) as u8
+        }
+        #[inline(always)]
+        fn lt(self, o: Self) -> u8 {
+            avx!(_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0))) as u8
+        }
+        #[inline(always)]
+        fn ge(self, o: Self) -> u8 {
+            avx!(_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_GE_OQ>(self.0, o.0))) as u8
+        }
+        #[inline(always)]
+        fn le(self, o: Self) -> u8 {
+            avx!(_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0))) as u8
+        }
+    }
+}
+
+/// The instruction sets the kernels can run on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Isa {
+    /// [`Portable`] lanes.
+    Portable,
+    /// [`Avx2`] lanes (x86-64 CPUs that have AVX2).
+    Avx2,
+}
+
+/// The instruction set the kernels run on in this process: AVX2 where the CPU
+/// has it, unless the environment variable `CONTINUUM_SIMD=portable` asks for
+/// the portable lanes (to compare the two; both give the same images).
+pub fn isa() -> Isa {
+    static ISA: OnceLock<Isa> = OnceLock::new();
+    *ISA.get_or_init(|| {
+        let portable = std::env::var("CONTINUUM_SIMD").is_ok_and(|v| v == "portable");
+        if !portable && cpu_has_avx2() {
+            Isa::Avx2
+        } else {
+            Isa::Portable
+        }
+    })
+}
+
+/// Does the CPU support AVX2?
+pub fn cpu_has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Whether the kernels take the AVX2 path ([`isa`]).
+#[inline(always)]
+pub fn avx2() -> bool {
+    isa() == Isa::Avx2
+}
+
+/// The mask of the first `n` lanes (all eight for `n ≥ 8`).
+#[inline(always)]
+pub(crate) fn first_lanes(n: usize) -> u8 {
+    ((1u16 << n.min(8)) - 1) as u8
+}
+
+/// Defines `fn NAME<G: Bound, ..>(args) -> R` that runs `BODY::<L, G, ..>(args)`
+/// on the lanes [`isa`] picks: `BODY` (generic over `L: Lanes` first, and
+/// `#[inline(always)]` down to the lane operations, so that all of it is
+/// compiled into the AVX2 form) once with [`Avx2`] inside an
+/// `#[target_feature(enable = "avx2")]` function, once with [`Portable`].
+macro_rules! dispatch {
+    ($(#[$meta:meta])* $vis:vis fn $name:ident<$($g:ident: $bound:path),*>($($arg:ident: $ty:ty),* $(,)?) -> $ret:ty => $body:ident) => {
+        $(#[$meta])*
+        $vis fn $name<$($g: $bound),*>($($arg: $ty),*) -> $ret {
+            #[cfg(target_arch = "x86_64")]
+            {
+                #[target_feature(enable = "avx2")]
+                fn on_avx2<$($g: $bound),*>($($arg: $ty),*) -> $ret {
+                    $body::<$crate::simd::Avx2, $($g),*>($($arg),*)
+                }
+                if $crate::simd::avx2() {
+                    // SAFETY: `avx2()` found that this CPU has AVX2.
+                    return unsafe { on_avx2($($arg),*) };
+                }
+            }
+            $body::<$crate::simd::Portable, $($g),*>($($arg),*)
+        }
+    };
+}
+pub(crate) use dispatch;
