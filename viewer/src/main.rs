@@ -63,6 +63,10 @@ struct Args {
     screenshot: Option<PathBuf>,
 }
 
+/// mimalloc reuses the frame-sized buffers every render allocates (see the server's).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn main() -> ExitCode {
     let args = Args::parse();
     let usage = |message: String| {
