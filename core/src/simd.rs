@@ -152,17 +152,17 @@ mod avx2_lanes {
         fn splat(v: f32) -> Self {
             Avx2(avx!(_mm256_set1_ps(v)))
         }
+        // Moves between lanes and arrays are bit casts, not load/store
+        // intrinsics: nothing that must be inlined to be fast.
         #[inline(always)]
         fn from_array(v: [f32; 8]) -> Self {
-            // SAFETY (beyond `avx!`'s): `v` holds eight f32, the unaligned load reads exactly them.
-            Avx2(avx!(_mm256_loadu_ps(v.as_ptr())))
+            // SAFETY: `[f32; 8]` and `__m256` are both 32 bytes of eight f32.
+            Avx2(unsafe { std::mem::transmute::<[f32; 8], __m256>(v) })
         }
         #[inline(always)]
         fn to_array(self) -> [f32; 8] {
-            let mut out = [0.0; 8];
-            // SAFETY (beyond `avx!`'s): `out` has room for exactly eight f32.
-            avx!(_mm256_storeu_ps(out.as_mut_ptr(), self.0));
-            out
+            // SAFETY: as in `from_array`.
+            unsafe { std::mem::transmute::<__m256, [f32; 8]>(self.0) }
         }
         #[inline(always)]
         fn max(self, o: Self) -> Self {

@@ -28,7 +28,14 @@ use crate::stats::Stats;
 /// must still be visited.
 const CULL_MARGIN: f32 = 1.0 + 1.0 / 1024.0;
 
-const BAND_ROWS: u32 = 4;
+/// Rows per parallel work item: one row of packets.
+const BAND_ROWS: u32 = BLOCK;
+
+/// Side of the pixel block whose rays walk the BVH as one packet.
+const BLOCK: u32 = 4;
+const _: () = assert!((BLOCK * BLOCK) as usize == PACKET);
+/// 8-lane groups per packet.
+const HALVES: usize = PACKET.div_ceil(8);
 
 /// Casts one ray per stored sample; `setup` gives the same triangles the 3D
 /// rasterizers of this viewport use. Under CSAA the coverage-only positions are
@@ -92,11 +99,11 @@ simd::dispatch! {
 }
 
 /// Every stored sample of the band's pixels, cast as packets: the rays of one
-/// sample position through the four pixels of a 2×2 quad walk the BVH together
-/// ([`SceneBvh::walk_packet`](crate::bvh::SceneBvh::walk_packet)), each ray
-/// tested on its own against every triangle the packet reaches, so each finds
-/// exactly the hit its single walk would; the quad is the one texture
-/// derivatives come from. Returns the BVH nodes visited.
+/// sample position through the sixteen pixels of a 4×4 block walk the BVH
+/// together ([`SceneBvh::walk_packet`](crate::bvh::SceneBvh::walk_packet)),
+/// each ray tested on its own against every triangle the packet reaches, so
+/// each finds exactly the hit its single walk would. Returns the BVH nodes
+/// visited.
 #[inline(always)]
 fn cast_band_on<L: Lanes, T: Coverage>(
     scene: &PreparedScene,
@@ -109,21 +116,24 @@ fn cast_band_on<L: Lanes, T: Coverage>(
     let mut nodes = 0;
     // Per lane: the BVH slot of each stored sample's triangle (CSAA).
     let mut slots = [[0u32; 8]; PACKET];
-    for y in (tile.y0..tile.y1).step_by(2) {
-        for x in (tile.x0..tile.x1).step_by(2) {
-            let quad = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)]
-                .map(|(px, py)| (px < tile.x1 && py < tile.y1).then_some((px, py)));
-            let index = quad.map(|p| p.map_or(0, |(px, py)| tile.index(px, py)));
+    for y in (tile.y0..tile.y1).step_by(BLOCK as usize) {
+        for x in (tile.x0..tile.x1).step_by(BLOCK as usize) {
+            let block: [Option<(u32, u32)>; PACKET] = std::array::from_fn(|l| {
+                let (px, py) = (x + l as u32 % BLOCK, y + l as u32 / BLOCK);
+                (px < tile.x1 && py < tile.y1).then_some((px, py))
+            });
+            let index = block.map(|p| p.map_or(0, |(px, py)| tile.index(px, py)));
             for (s, &[ox, oy]) in pattern.positions[..stored].iter().enumerate() {
-                let points = quad.map(|p| p.map(|(px, py)| (px as f32 + ox, py as f32 + oy)));
+                let points = block.map(|p| p.map(|(px, py)| (px as f32 + ox, py as f32 + oy)));
                 // No ray outside the viewport (the parabolic disc): background.
                 let rays = points.map(|p| p.and_then(|(xs, ys)| view.ray(xs, ys)));
-                // The packet's samples as the first lanes of one 8-lane test.
-                let (mut xs, mut ys, mut present) = ([0.0; 8], [0.0; 8], 0u8);
+                // The packet's samples as two 8-lane tests (`present`: the rays cast).
+                let (mut xs, mut ys, mut present) =
+                    ([[0.0; 8]; HALVES], [[0.0; 8]; HALVES], [0u8; HALVES]);
                 for (l, p) in points.iter().enumerate() {
                     if let (Some(_), Some((px, py))) = (rays[l], *p) {
-                        (xs[l], ys[l]) = (px, py);
-                        present |= 1 << l;
+                        (xs[l / 8][l % 8], ys[l / 8][l % 8]) = (px, py);
+                        present[l / 8] |= 1 << (l % 8);
                     }
                 }
                 let mut best = [(f32::INFINITY, BACKGROUND, 0u32); PACKET];
@@ -139,25 +149,31 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                     };
                     let id = scene.slot_triangles[k as usize];
                     let see_through = is_see_through(opacity, id);
-                    let (mut hits, depth) = tri.sample_points8::<L>(xs, ys, present);
-                    for (l, e) in evals.iter_mut().enumerate() {
-                        *e += u32::from(present >> l & 1);
-                    }
-                    while hits != 0 {
-                        let l = hits.trailing_zeros() as usize;
-                        hits &= hits - 1;
-                        let w = depth[l];
-                        covered[l] += 1;
-                        if see_through {
-                            fragments.push(Fragment {
-                                sample: (s * pixels + index[l]) as u32,
-                                w,
-                                id,
-                            });
-                        } else if wins_depth_test(w, id, best[l].0, best[l].1) {
-                            best[l] = (w, id, k);
-                            cull[l] = w * CULL_MARGIN;
+                    for half in 0..HALVES {
+                        if present[half] == 0 {
+                            continue;
                         }
+                        let (mut hits, depth) =
+                            tri.sample_points8::<L>(xs[half], ys[half], present[half]);
+                        while hits != 0 {
+                            let l = hits.trailing_zeros() as usize;
+                            hits &= hits - 1;
+                            let (w, lane) = (depth[l], half * 8 + l);
+                            covered[lane] += 1;
+                            if see_through {
+                                fragments.push(Fragment {
+                                    sample: (s * pixels + index[lane]) as u32,
+                                    w,
+                                    id,
+                                });
+                            } else if wins_depth_test(w, id, best[lane].0, best[lane].1) {
+                                best[lane] = (w, id, k);
+                                cull[lane] = w * CULL_MARGIN;
+                            }
+                        }
+                    }
+                    for (l, e) in evals.iter_mut().enumerate() {
+                        *e += u32::from(present[l / 8] >> (l % 8) & 1);
                     }
                 });
                 for l in 0..PACKET {
@@ -175,7 +191,7 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                 }
             }
             if pattern.has_coverage_only() {
-                for (l, p) in quad.into_iter().enumerate() {
+                for (l, p) in block.into_iter().enumerate() {
                     if let Some(p) = p {
                         stored_masks::<L, T>(setups, &slots[l], tile, p);
                         nodes += lost_coverage::<L, T>(scene, view, setups, tile, p);
