@@ -249,7 +249,7 @@ fn child_mask(node: &CwBvhNode, mut hits: u32, oct_inv4: u32) -> u32 {
 /// the min/max combinations of them: a box is missed by every ray when the
 /// packet's nearest possible entry lies beyond its farthest possible exit (or
 /// beyond every ray's culling distance). Conservative against each ray's own
-/// [`SlabRay::hits8`] bit for bit, so no ray loses a node its single walk enters.
+/// `SlabRay::hits8` bit for bit, so no ray loses a node its single walk enters.
 #[derive(Clone, Copy, Debug)]
 pub struct PacketInterval {
     origin_lo: [f32; 3],

@@ -1,6 +1,7 @@
 //! Eight f32 lanes for the per-sample loops, in the instruction set the CPU has.
 //!
-//! The coverage kernels ([`crate::edge::Coverage`]'s 8-lane methods) are
+//! The coverage kernels ([`crate::edge::Coverage`]'s 8-lane methods, on 2D,
+//! homogeneous and 3D edge functions) are
 //! written once, generic over [`Lanes`], and compiled twice: on [`Portable`]
 //! (`wide::f32x8`: two SSE halves on x86-64, whatever the target has
 //! elsewhere) and on [`Avx2`] (one 256-bit register). Which one runs is
@@ -50,6 +51,7 @@ mod sealed {
         fn lt(self, o: Self) -> u8;
         fn ge(self, o: Self) -> u8;
         fn le(self, o: Self) -> u8;
+        fn eq(self, o: Self) -> u8;
     }
 }
 
@@ -90,6 +92,10 @@ impl sealed::Ops for Portable {
     fn le(self, o: Self) -> u8 {
         self.simd_le(o).to_bitmask() as u8
     }
+    #[inline(always)]
+    fn eq(self, o: Self) -> u8 {
+        self.simd_eq(o).to_bitmask() as u8
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -103,7 +109,7 @@ mod avx2_lanes {
     /// Eight lanes in one AVX register. No value of this type exists except
     /// inside a function compiled with `#[target_feature(enable = "avx2")]`
     /// that was entered after [`super::avx2`] said the CPU has it: the only
-    /// constructors are the sealed [`super::sealed::Ops`] methods, called by
+    /// constructors are the sealed `Ops` methods, called by
     /// this crate's kernels on that path alone.
     #[derive(Clone, Copy, Debug)]
     pub struct Avx2(__m256);
@@ -187,6 +193,10 @@ mod avx2_lanes {
         #[inline(always)]
         fn le(self, o: Self) -> u8 {
             avx!(_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0))) as u8
+        }
+        #[inline(always)]
+        fn eq(self, o: Self) -> u8 {
+            avx!(_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(self.0, o.0))) as u8
         }
     }
 }

@@ -650,6 +650,9 @@ impl Coverage for Triangle3D<'_> {
 mod tests {
     use super::*;
     use crate::camera::Camera;
+    use crate::edge::lanes_test::lanes_agree;
+    #[cfg(target_arch = "x86_64")]
+    use crate::edge::lanes_test::lanes_agree_avx2;
 
     /// Every 8-lane method gives exactly the scalar path's coverage and depth
     /// in the lanes it is asked for (and nothing in the others), on the
@@ -691,7 +694,7 @@ mod tests {
             } else {
                 (n / 2 % 255 + 1) as u8
             };
-            let (count, portable_covers) = lanes_agree::<crate::simd::Portable>(&t, active);
+            let (count, portable_covers) = lanes_agree::<crate::simd::Portable, _>(&t, active);
             compared += count;
             #[cfg(target_arch = "x86_64")]
             {
@@ -705,54 +708,5 @@ mod tests {
             compared > 20_000,
             "only {compared} covered samples compared"
         );
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn lanes_agree_avx2(t: &Triangle3D, active: u8) -> (usize, Vec<u8>) {
-        lanes_agree::<crate::simd::Avx2>(t, active)
-    }
-
-    /// Compares `sample8`, `sample_points8`, `covers8` and `depth_inside8`
-    /// on lanes `L` with the scalar path over the 64×48 image (`covers8`,
-    /// which skips the depth clamp, against the other lanes); returns the
-    /// number of covered samples compared and the `covers8` masks.
-    fn lanes_agree<L: Lanes>(t: &Triangle3D, active: u8) -> (usize, Vec<u8>) {
-        let (mut compared, mut covers) = (0, Vec::new());
-        for y in 0..48 {
-            let yc = y as f32 + 0.5;
-            for x0 in (0..64).step_by(8) {
-                let (mask, depth) = t.sample8::<L>(x0 as f32 + 0.5, yc, active);
-                // The same pixels as points, a quarter pixel off their centres.
-                let xs = std::array::from_fn(|k| (x0 + k) as f32 + 0.25);
-                let ys = [yc + 0.25; 8];
-                let (point_mask, point_depth) = t.sample_points8::<L>(xs, ys, active);
-                covers.push(t.covers8::<L>(xs, ys));
-                let (inside_mask, inside_depth) = t.depth_inside8::<L>(xs, ys);
-                for k in 0..8 {
-                    let on = |m: u8| m >> k & 1 == 1;
-                    let at = format!("pixel ({}, {y}), lanes {active:#010b}", x0 + k);
-                    let scalar = t.sample((x0 + k) as f32 + 0.5, yc).filter(|_| on(active));
-                    let lane = on(mask).then_some(depth[k]);
-                    assert_eq!(scalar.map(f32::to_bits), lane.map(f32::to_bits), "{at}");
-                    let scalar = t.sample(xs[k], ys[k]);
-                    let lane = on(point_mask).then_some(point_depth[k]);
-                    assert_eq!(
-                        scalar.filter(|_| on(active)).map(f32::to_bits),
-                        lane.map(f32::to_bits),
-                        "points: {at}"
-                    );
-                    let scalar = t.depth_inside(xs[k], ys[k]);
-                    let lane = on(inside_mask).then_some(inside_depth[k]);
-                    assert_eq!(
-                        scalar.map(f32::to_bits),
-                        lane.map(f32::to_bits),
-                        "inside: {at}"
-                    );
-                    compared += usize::from(scalar.is_some());
-                }
-            }
-        }
-        (compared, covers)
     }
 }
