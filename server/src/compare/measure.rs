@@ -1,7 +1,9 @@
 //! Measuring the cells of a sweep: every algorithm and peer of a cell timed
-//! over repeats, with the relations only the cell's own buffers can decide —
-//! family agreement, pixels a peer differs by, error against the `ssaa:256`
-//! reference — and an edge-evaluation thumbnail per render for the report.
+//! over repeats (continuum's algorithms interleaved, round by round; each peer
+//! in one block, since it owns its acceleration structure), with the relations
+//! only the cell's own buffers can decide — family agreement, pixels a peer
+//! differs by, error against the `ssaa:256` reference — and an
+//! edge-evaluation thumbnail per render for the report.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -84,9 +86,12 @@ pub fn measure_cell(
         }
         scene.references.get(&key)
     };
-    let mut measured: Vec<Measured> = Vec::new();
-    for &entry in &sweep.entries {
-        let serves = match entry {
+    // 1. What serves this cell, in the sweep's order.
+    let serving: Vec<Entry> = sweep
+        .entries
+        .iter()
+        .copied()
+        .filter(|&entry| match entry {
             Entry::Algorithm(a) => {
                 camera.viewport.serves(a)
                     && cell.precision.serves(a.family())
@@ -97,10 +102,54 @@ pub fn measure_cell(
             }
             // Peers cast one ray per pixel in their own precision.
             Entry::Peer(_) => cell.aa == AaMode::None && cell.precision == Precision::F32,
-        };
-        if !serves {
-            continue;
+        })
+        .collect();
+    // 2. continuum's algorithms, timed interleaved: one warm-up render each
+    //    (the GPU uploads the scene then), then `repeat` rounds of one render
+    //    per algorithm, so slow drift of the machine reaches every algorithm
+    //    of the cell alike and the ratios between them stay fair.
+    let algorithms: Vec<AlgorithmId> = serving
+        .iter()
+        .filter_map(|e| match e {
+            Entry::Algorithm(a) => Some(*a),
+            Entry::Peer(_) => None,
+        })
+        .collect();
+    let mut timed = Vec::new();
+    for &a in &algorithms {
+        progress.set_message(format!(
+            "{name} {} {} {}: {} (warm-up)",
+            camera.viewport,
+            cell.aa,
+            cell.precision,
+            a.as_str()
+        ));
+        let request = algorithm_request(a, &camera, cell, sweep);
+        timed.push((
+            request.clone(),
+            render_in(pool, scene, &request)?,
+            Vec::new(),
+        ));
+    }
+    for round in 0..sweep.repeat {
+        progress.set_message(format!(
+            "{name} {} {} {}: round {} of {} over {} algorithms",
+            camera.viewport,
+            cell.aa,
+            cell.precision,
+            round + 1,
+            sweep.repeat,
+            algorithms.len()
+        ));
+        for (request, out, times) in &mut timed {
+            *out = render_in(pool, scene, request)?;
+            times.push(out.stats.time_ms.total);
         }
+    }
+    let mut timed = timed.into_iter();
+    // 3. The rows in the sweep's order; peers timed each in its own block.
+    let mut measured: Vec<Measured> = Vec::new();
+    for entry in serving {
         progress.set_message(format!(
             "{name} {} {} {}: {}",
             camera.viewport,
@@ -110,7 +159,8 @@ pub fn measure_cell(
         ));
         let mut m = match entry {
             Entry::Algorithm(a) => {
-                measure_algorithm(pool, scene, &camera, (a, cell), sweep, threads)?
+                let (_, out, times) = timed.next().context("one timed render per algorithm")?;
+                algorithm_row(scene, (a, cell), sweep, threads, out, times)
             }
             Entry::Peer(p) => {
                 let view = View::new(&camera, width, height, scene.prepared.default_near)
@@ -156,15 +206,14 @@ struct Measured {
     fb: Option<Framebuffer>,
 }
 
-fn measure_algorithm(
-    pool: &rayon::ThreadPool,
-    scene: &LoadedScene,
+/// The request that renders `algorithm` in `cell`.
+fn algorithm_request(
+    algorithm: AlgorithmId,
     camera: &Camera,
-    (algorithm, cell): (AlgorithmId, &Cell),
+    cell: &Cell,
     sweep: &Sweep,
-    threads: usize,
-) -> Result<Measured, CliError> {
-    let request = RenderRequest {
+) -> RenderRequest {
+    RenderRequest {
         algorithm,
         oracles: None,
         camera: camera.clone(),
@@ -173,18 +222,27 @@ fn measure_algorithm(
         aa: cell.aa,
         precision: cell.precision,
         texture_filter: Default::default(),
-    };
-    let run = || {
-        pool.install(|| render(&scene.prepared, &request))
-            .map_err(|e| CliError::Usage(format!("{e}")))
-    };
-    // One warm-up render (the GPU uploads the scene then), then the timed ones.
-    let mut out = run()?;
-    let mut times = Vec::new();
-    for _ in 0..sweep.repeat {
-        out = run()?;
-        times.push(out.stats.time_ms.total);
     }
+}
+
+fn render_in(
+    pool: &rayon::ThreadPool,
+    scene: &LoadedScene,
+    request: &RenderRequest,
+) -> Result<continuum::RenderOutput, CliError> {
+    pool.install(|| render(&scene.prepared, request))
+        .map_err(|e| CliError::Usage(format!("{e}")))
+}
+
+/// The row of an algorithm from its last render and the times of its rounds.
+fn algorithm_row(
+    scene: &LoadedScene,
+    (algorithm, cell): (AlgorithmId, &Cell),
+    sweep: &Sweep,
+    threads: usize,
+    out: continuum::RenderOutput,
+    times: Vec<f64>,
+) -> Measured {
     let mut row = Row::timed(
         &scene.prepared.scene.name,
         algorithm.as_str(),
@@ -207,11 +265,11 @@ fn measure_algorithm(
     } else {
         fb.sample_digest.clone()
     };
-    Ok(Measured {
+    Measured {
         row,
         keys,
         fb: Some(fb),
-    })
+    }
 }
 
 /// Family agreement (the first member of each family in the cell is its
