@@ -15,7 +15,7 @@
 use glam::{Vec3, Vec3A};
 
 use crate::algorithm::PixelRect;
-use crate::algorithm::setup3d::screen_rect;
+use crate::algorithm::setup3d::ScreenBoxes;
 use crate::binning::{SampleOracles, raster_triangle};
 use crate::bvh::{SlabRay, padded};
 use crate::camera::View;
@@ -50,6 +50,8 @@ pub(crate) struct Traversal<'a, 't, T> {
     pub oracles: TraversalOracles,
     pub tile: &'t mut TileBuffer<'a>,
     pub setup: Setup<'a, T>,
+    /// The leaf triangles' screen boxes.
+    pub boxes: &'t ScreenBoxes,
     pub counters: RasterCounters,
     pub nodes_visited: u64,
     pub setups: u64,
@@ -72,13 +74,14 @@ struct NodeBox {
 
 impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
     /// A traversal of the frustum over `tile`'s pixels, leaf triangles set up
-    /// by `setup`.
+    /// by `setup` over their `boxes`.
     pub fn new(
         scene: &'a PreparedScene,
         view: &'a View,
         oracles: TraversalOracles,
         tile: &'t mut TileBuffer<'a>,
         setup: Setup<'a, T>,
+        boxes: &'t ScreenBoxes,
     ) -> Self {
         Traversal {
             scene,
@@ -86,6 +89,7 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
             oracles,
             tile,
             setup,
+            boxes,
             counters: RasterCounters::default(),
             nodes_visited: 0,
             setups: 0,
@@ -277,7 +281,10 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
             let k = scene.bvh.cwbvh.primitive_indices[slot as usize];
             let id = scene.drawable[k as usize];
             let p = &scene.triangles[id as usize];
-            let Some(rect) = screen_rect(p, self.view, self.tile.pattern.span) else {
+            let Some(rect) = self
+                .boxes
+                .rect(scene, id, self.view, self.tile.pattern.span)
+            else {
                 continue;
             };
             let Some(clip) = rect.intersect(f) else {

@@ -414,6 +414,8 @@ fn render_frusta<'a, T: crate::edge::Coverage>(
     setup: Setup<'a, T>,
 ) -> Pass {
     let start = Instant::now();
+    let boxes = setup3d::ScreenBoxes::new(scene, context.view);
+    let boxes = &boxes;
     let done: Vec<_> = fb
         .tile_rects(oracles.frustum)
         .into_par_iter()
@@ -421,7 +423,7 @@ fn render_frusta<'a, T: crate::edge::Coverage>(
             || None,
             |cache, rect| {
                 context.run_tile(cache, rect, |tile| {
-                    let mut t = Traversal::new(scene, context.view, oracles, tile, setup);
+                    let mut t = Traversal::new(scene, context.view, oracles, tile, setup, boxes);
                     t.run();
                     (t.counters, t.nodes_visited, t.setups)
                 })

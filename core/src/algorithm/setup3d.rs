@@ -57,11 +57,7 @@ fn setup_visible<'a, T: Send>(
     span: SampleSpan,
     setup: impl Fn(&'a [Vec3; 3], &'a View) -> Option<T> + Sync,
 ) -> Vec<Option<Placed<T>>> {
-    // Planar views: every vertex projected once, not once per triangle using it.
-    let projected = view
-        .sphere
-        .is_none()
-        .then(|| VertexPoints::new(scene, view));
+    let boxes = ScreenBoxes::new(scene, view);
     // One slot per drawable triangle (an exactly sized, parallel collect: no
     // chunks to concatenate); `None` for the ones off screen or edge-on.
     scene
@@ -69,10 +65,7 @@ fn setup_visible<'a, T: Send>(
         .par_iter()
         .map(|&id| {
             let p = &scene.triangles[id as usize];
-            let rect = match &projected {
-                Some(points) => points.rect(scene, id, view, span),
-                None => screen_rect(p, view, span),
-            }?;
+            let rect = boxes.rect(scene, id, view, span)?;
             Some(Placed {
                 tri: setup(p, view)?,
                 rect,
@@ -129,44 +122,56 @@ fn near_bound(view: &View) -> f32 {
     view.near * (1.0 - 1.0 / 1024.0)
 }
 
-/// The image points of every mesh vertex for one planar view (`None` for
-/// vertices nearer than [`near_bound`]): the same values [`screen_rect`]
-/// computes, once per vertex.
-struct VertexPoints {
-    points: Vec<Option<(f32, f32)>>,
+/// [`screen_rect`] of every triangle of one view, with planar views'
+/// vertices projected once (not once per triangle using them): the image
+/// point of every mesh vertex, `None` for vertices nearer than [`near_bound`].
+pub(crate) struct ScreenBoxes {
+    points: Option<Vec<Option<(f32, f32)>>>,
 }
 
-impl VertexPoints {
-    fn new(scene: &PreparedScene, view: &View) -> VertexPoints {
+impl ScreenBoxes {
+    pub(crate) fn new(scene: &PreparedScene, view: &View) -> ScreenBoxes {
         let near_bound = near_bound(view);
-        let points = scene
-            .scene
-            .mesh
-            .positions
-            .par_iter()
-            .map(|&p| {
-                let c = view.to_camera(p);
-                (c.z >= near_bound).then(|| view.project(c))
-            })
-            .collect();
-        VertexPoints { points }
+        let points = view.sphere.is_none().then(|| {
+            scene
+                .scene
+                .mesh
+                .positions
+                .par_iter()
+                .map(|&p| {
+                    let c = view.to_camera(p);
+                    (c.z >= near_bound).then(|| view.project(c))
+                })
+                .collect()
+        });
+        ScreenBoxes { points }
     }
 
     /// [`screen_rect`] of triangle `id` (`scene.triangles[id]` are its mesh
     /// vertices' positions, so the points are the ones it would compute).
-    fn rect(
+    pub(crate) fn rect(
         &self,
         scene: &PreparedScene,
         id: u32,
         view: &View,
         span: SampleSpan,
     ) -> Option<PixelRect> {
+        let p = &scene.triangles[id as usize];
+        let Some(points) = &self.points else {
+            return screen_rect(p, view, span);
+        };
+        let points = scene.scene.mesh.triangles[id as usize].map(|v| points[v as usize]);
+        // Every vertex nearer than the bound: so is every point of the
+        // triangle, which has no sample at `w ≥ near`.
+        if points.iter().all(Option::is_none) {
+            return None;
+        }
         let mut image_box = ImageBox::EMPTY;
-        for v in scene.scene.mesh.triangles[id as usize] {
-            match self.points[v as usize] {
+        for point in points {
+            match point {
                 Some(point) => image_box.grow(point),
                 // Reaches nearer than near: clipped.
-                None => return screen_rect(&scene.triangles[id as usize], view, span),
+                None => return screen_rect(p, view, span),
             }
         }
         image_box.pixels(view, span)
