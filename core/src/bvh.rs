@@ -206,11 +206,16 @@ impl SceneBvh {
                         let tmax = cull.iter().fold(f32::NEG_INFINITY, |m, &c| m.max(c));
                         interval.hits::<L>(boxes, tmax)
                     }
-                    None => slabs
-                        .iter()
-                        .zip(&cull)
-                        .filter_map(|(slab, &tmax)| Some(slab.as_ref()?.hits8::<L>(boxes, tmax)))
-                        .fold(0, |m, h| m | h),
+                    // A loop, not a closure: lane code must be inlined (see `crate::simd`).
+                    None => {
+                        let mut hits = 0;
+                        for (slab, &tmax) in slabs.iter().zip(&cull) {
+                            if let Some(slab) = slab {
+                                hits |= slab.hits8::<L>(boxes, tmax);
+                            }
+                        }
+                        hits
+                    }
                 };
                 child_mask(node, hits, state.oct_inv4)
             },

@@ -12,6 +12,11 @@
 //! for it), so every lane rounds exactly as the scalar [`Coverage::sample`]
 //! does, on either path.
 //!
+//! Lane code is written in `#[inline(always)]` functions, never in closures:
+//! only what is inlined into the `#[target_feature]` loop is compiled for
+//! AVX2, and an intrinsic left outside it becomes a call per instruction
+//! (`.ci/run` checks the binary for such calls).
+//!
 //! [`Coverage::sample`]: crate::edge::Coverage::sample
 
 use std::ops::{Add, Div, Mul, Sub};
@@ -154,12 +159,12 @@ mod avx2_lanes {
     }
 
     impl super::sealed::Ops for Avx2 {
+        // Moves between lanes and arrays are bit casts, not broadcast, load or
+        // store intrinsics: nothing that must be inlined to be fast.
         #[inline(always)]
         fn splat(v: f32) -> Self {
-            Avx2(avx!(_mm256_set1_ps(v)))
+            Self::from_array([v; 8])
         }
-        // Moves between lanes and arrays are bit casts, not load/store
-        // intrinsics: nothing that must be inlined to be fast.
         #[inline(always)]
         fn from_array(v: [f32; 8]) -> Self {
             // SAFETY: `[f32; 8]` and `__m256` are both 32 bytes of eight f32.

@@ -121,14 +121,23 @@ impl Triangle2D {
 /// [`LinearEdges::depth`]: the same operations in the same order, so every
 /// lane rounds as [`linear_sample`] does ([`crate::simd`]).
 impl Triangle2D {
-    /// The three signed edge values per lane.
+    /// The three signed edge values per lane. (No closures in lane code: only
+    /// `#[inline(always)]` functions are sure to be compiled for the caller's lanes.)
     #[inline(always)]
     fn edge_lanes<L: Lanes>(&self, x: L, y: L) -> [L; 3] {
-        std::array::from_fn(|i| {
-            let ([lx, ly], [dx, dy]) = (self.lo[i], self.delta[i]);
-            (L::splat(dx) * (y - L::splat(ly)) - L::splat(dy) * (x - L::splat(lx)))
-                * L::splat(self.sign[i])
-        })
+        [
+            self.edge_lane(0, x, y),
+            self.edge_lane(1, x, y),
+            self.edge_lane(2, x, y),
+        ]
+    }
+
+    /// Edge `i`'s signed value per lane.
+    #[inline(always)]
+    fn edge_lane<L: Lanes>(&self, i: usize, x: L, y: L) -> L {
+        let ([lx, ly], [dx, dy]) = (self.lo[i], self.delta[i]);
+        (L::splat(dx) * (y - L::splat(ly)) - L::splat(dy) * (x - L::splat(lx)))
+            * L::splat(self.sign[i])
     }
 
     /// The lanes of `mask` with a depth, and the depths (clamped like the scalar's).
