@@ -1,6 +1,6 @@
 //! Measuring the cells of a sweep: every algorithm and peer of a cell timed
-//! over repeats (continuum's algorithms interleaved, round by round; each peer
-//! in one block, since it owns its acceleration structure), with the relations
+//! over repeats (continuum's CPU algorithms interleaved, round by round;
+//! `gpu-raster` and each peer in one block), with the relations
 //! only the cell's own buffers can decide — family agreement, pixels a peer
 //! differs by, error against the `ssaa:256` reference — and an
 //! edge-evaluation thumbnail per render for the report.
@@ -104,15 +104,17 @@ pub fn measure_cell(
             Entry::Peer(_) => cell.aa == AaMode::None && cell.precision == Precision::F32,
         })
         .collect();
-    // 2. continuum's algorithms, timed interleaved: one warm-up render each
-    //    (the GPU uploads the scene then), then `repeat` rounds of one render
-    //    per algorithm, so slow drift of the machine reaches every algorithm
-    //    of the cell alike and the ratios between them stay fair.
+    // 2. continuum's CPU algorithms, timed interleaved: one warm-up render
+    //    each, then `repeat` rounds of one render per algorithm, so slow drift
+    //    of the machine reaches every algorithm of the cell alike and the
+    //    ratios between them stay fair. (`gpu-raster` is timed in a block of
+    //    its own like the peers: lavapipe's threads outlive its frames and
+    //    would slow whichever render came next.)
     let algorithms: Vec<AlgorithmId> = serving
         .iter()
         .filter_map(|e| match e {
-            Entry::Algorithm(a) => Some(*a),
-            Entry::Peer(_) => None,
+            Entry::Algorithm(a) if *a != AlgorithmId::GpuRaster => Some(*a),
+            _ => None,
         })
         .collect();
     let mut timed = Vec::new();
@@ -158,6 +160,24 @@ pub fn measure_cell(
             entry.name()
         ));
         let mut m = match entry {
+            Entry::Algorithm(AlgorithmId::GpuRaster) => {
+                // One warm-up render (the GPU uploads the scene then), then the timed ones.
+                let request = algorithm_request(AlgorithmId::GpuRaster, &camera, cell, sweep);
+                let mut out = render_in(pool, scene, &request)?;
+                let mut times = Vec::new();
+                for _ in 0..sweep.repeat {
+                    out = render_in(pool, scene, &request)?;
+                    times.push(out.stats.time_ms.total);
+                }
+                algorithm_row(
+                    scene,
+                    (AlgorithmId::GpuRaster, cell),
+                    sweep,
+                    threads,
+                    out,
+                    times,
+                )
+            }
             Entry::Algorithm(a) => {
                 let (_, out, times) = timed.next().context("one timed render per algorithm")?;
                 algorithm_row(scene, (a, cell), sweep, threads, out, times)
