@@ -10,7 +10,7 @@ use super::PixelRect;
 use super::tiles::Placed;
 use crate::aa::SampleSpan;
 use crate::camera::View;
-use crate::clip::{GUARD_BAND, clip_triangle, fixed_guard_band, pipeline_planes};
+use crate::clip::{GUARD_BAND, MAX_CLIPPED, clip_triangle, fixed_guard_band, pipeline_planes};
 use crate::edge::{ScreenVertex, Triangle2D, Triangle2DFixed};
 use crate::prepared::PreparedScene;
 
@@ -55,22 +55,25 @@ fn setup_pieces<T: Send>(
 ) -> Vec<Option<Placed<T>>> {
     let planes = pipeline_planes(view, guard);
     let affine = view.is_orthographic();
+    // Each triangle's pieces, in order (rayon collects the per-job lists
+    // into one exactly sized Vec: one copy, no growing and appending).
     scene
         .drawable
         .par_iter()
-        .fold(Vec::new, |mut out, &id| {
+        .flat_map_iter(|&id| {
+            let mut pieces: [Option<Placed<T>>; MAX_CLIPPED - 2] = std::array::from_fn(|_| None);
             // 1. Transform and clip.
             let p = &scene.triangles[id as usize];
             let cam = p.map(|v| view.to_camera_f64(v));
             let Some(poly) = clip_triangle(cam, &planes) else {
-                return out;
+                return pieces.into_iter().flatten();
             };
             // 2. Project (the polygon has at most 8 vertices).
             let mut screen = [ScreenVertex {
                 x: 0.0,
                 y: 0.0,
                 q: 0.0,
-            }; crate::clip::MAX_CLIPPED];
+            }; MAX_CLIPPED];
             for (s, c) in screen.iter_mut().zip(poly.as_slice()) {
                 let (x, y) = view.project_f64(*c);
                 *s = ScreenVertex {
@@ -88,13 +91,11 @@ fn setup_pieces<T: Send>(
                 if let Some(rect) =
                     PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height, span)
                 {
-                    out.push(Some(Placed { tri, rect, id }));
+                    pieces[k - 1] = Some(Placed { tri, rect, id });
                 }
             }
-            out
+            pieces.into_iter().flatten()
         })
-        .reduce(Vec::new, |mut a, mut b| {
-            a.append(&mut b);
-            a
-        })
+        .map(Some)
+        .collect()
 }
