@@ -246,6 +246,15 @@ fn child_mask(node: &CwBvhNode, mut hits: u32, oct_inv4: u32) -> u32 {
     mask
 }
 
+/// The children (bit per lane) whose per-axis slab intervals `(near, far)`
+/// overlap each other and `[0, tmax]`.
+#[inline(always)]
+fn overlapping<L: Lanes>([(nx, fx), (ny, fy), (nz, fz)]: [(L, L); 3], tmax: f32) -> u32 {
+    let near = nx.max(ny).max(nz.max(L::splat(0.0)));
+    let far = fx.min(fy).min(fz.min(L::splat(tmax)));
+    u32::from(near.le(far))
+}
+
 /// The slab tests of a packet of rays from one origin, by interval arithmetic
 /// over the packet (Wald et al. style): per axis the smallest and largest
 /// reciprocal direction of its rays. For a box coordinate `q` every ray's slab
@@ -290,12 +299,13 @@ impl PacketInterval {
     /// `tmax` (the largest culling distance of the packet).
     #[inline(always)]
     fn hits<L: Lanes>(&self, boxes: &ChildBoxes, tmax: f32) -> u32 {
-        let (nx, fx) = self.axis::<L>(boxes, 0);
-        let (ny, fy) = self.axis::<L>(boxes, 1);
-        let (nz, fz) = self.axis::<L>(boxes, 2);
-        let near = nx.max(ny).max(nz.max(L::splat(0.0)));
-        let far = fx.min(fy).min(fz.min(L::splat(tmax)));
-        u32::from(near.le(far))
+        // An array, not a `map` closure: lane code must be inlined (`crate::simd`).
+        let axes = [
+            self.axis::<L>(boxes, 0),
+            self.axis::<L>(boxes, 1),
+            self.axis::<L>(boxes, 2),
+        ];
+        overlapping(axes, tmax)
     }
 
     /// Along axis `a`, per child: a lower bound of every ray's slab entry
@@ -380,12 +390,13 @@ impl SlabRay {
     /// eight slab tests side by side.
     #[inline(always)]
     fn hits8<L: Lanes>(&self, boxes: &ChildBoxes, tmax: f32) -> u32 {
-        let (nx, fx) = self.axis::<L>(boxes, 0);
-        let (ny, fy) = self.axis::<L>(boxes, 1);
-        let (nz, fz) = self.axis::<L>(boxes, 2);
-        let near = nx.max(ny).max(nz.max(L::splat(0.0)));
-        let far = fx.min(fy).min(fz.min(L::splat(tmax)));
-        u32::from(near.le(far))
+        // An array, not a `map` closure: lane code must be inlined (`crate::simd`).
+        let axes = [
+            self.axis::<L>(boxes, 0),
+            self.axis::<L>(boxes, 1),
+            self.axis::<L>(boxes, 2),
+        ];
+        overlapping(axes, tmax)
     }
 
     /// Along axis `a`, per child: the slab entry and exit distances.

@@ -137,7 +137,8 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                     }
                 }
                 let mut best = [(f32::INFINITY, BACKGROUND, 0u32); PACKET];
-                let (mut evals, mut covered) = ([0u32; PACKET], [0u32; PACKET]);
+                // Every ray of the packet tests every triangle it reaches.
+                let (mut tested, mut covered) = (0u32, [0u32; PACKET]);
                 // See-through triangles leave fragments, as in the rasterizers'
                 // `TileBuffer::write`; the walk still culls beyond the nearest
                 // opaque hit, behind which no fragment shows.
@@ -172,16 +173,14 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                             }
                         }
                     }
-                    for (l, e) in evals.iter_mut().enumerate() {
-                        *e += u32::from(present[l / 8] >> (l % 8) & 1);
-                    }
+                    tested += 1;
                 });
                 for l in 0..PACKET {
                     if rays[l].is_none() {
                         continue;
                     }
                     let (i, j) = (index[l], s * pixels + index[l]);
-                    tile.edge_evals[i] += evals[l];
+                    tile.edge_evals[i] += tested;
                     tile.coverage_writes[j] = covered[l];
                     let (w, id, slot) = best[l];
                     (tile.depth[j], tile.triangle_id[j]) = (w, id);

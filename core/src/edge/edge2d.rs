@@ -177,12 +177,6 @@ impl Coverage for Triangle2D {
     }
 
     #[inline(always)]
-    fn sample8<L: Lanes>(&self, x0: f32, y: f32, active: u8) -> (u8, [f32; 8]) {
-        let x = L::splat(x0) + L::from_array([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
-        self.sample_lanes(x, L::splat(y), active)
-    }
-
-    #[inline(always)]
     fn sample_points8<L: Lanes>(&self, x: [f32; 8], y: [f32; 8], active: u8) -> (u8, [f32; 8]) {
         self.sample_lanes(L::from_array(x), L::from_array(y), active)
     }

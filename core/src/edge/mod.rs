@@ -70,9 +70,11 @@ pub trait Coverage {
     /// gives for each, on either instruction set `L` (implementations that
     /// vectorise it must round alike: no fused multiply-add, the same
     /// operation order).
+    /// (The points `x0 + k` are rounded as a lane's `x0 + k` would be.)
     #[inline(always)]
     fn sample8<L: Lanes>(&self, x0: f32, y: f32, active: u8) -> (u8, [f32; 8]) {
-        lanes8(active, |k| self.sample(x0 + k as f32, y))
+        let x = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0].map(|k| x0 + k);
+        self.sample_points8::<L>(x, [y; 8], active)
     }
 
     /// Coverage and depth of eight samples at any points `(x[k], y[k])` (the

@@ -117,37 +117,19 @@ pub fn measure_cell(
             _ => None,
         })
         .collect();
-    let mut timed = Vec::new();
-    for &a in &algorithms {
-        progress.set_message(format!(
-            "{name} {} {} {}: {} (warm-up)",
-            camera.viewport,
-            cell.aa,
-            cell.precision,
-            a.as_str()
-        ));
-        let request = algorithm_request(a, &camera, cell, sweep);
-        timed.push((
-            request.clone(),
-            render_in(pool, scene, &request)?,
-            Vec::new(),
-        ));
-    }
-    for round in 0..sweep.repeat {
-        progress.set_message(format!(
-            "{name} {} {} {}: round {} of {} over {} algorithms",
-            camera.viewport,
-            cell.aa,
-            cell.precision,
-            round + 1,
-            sweep.repeat,
-            algorithms.len()
-        ));
-        for (request, out, times) in &mut timed {
-            *out = render_in(pool, scene, request)?;
-            times.push(out.stats.time_ms.total);
-        }
-    }
+    progress.set_message(format!(
+        "{name} {} {} {}: {} algorithms over {} rounds",
+        camera.viewport,
+        cell.aa,
+        cell.precision,
+        algorithms.len(),
+        sweep.repeat
+    ));
+    let requests: Vec<RenderRequest> = algorithms
+        .iter()
+        .map(|&a| algorithm_request(a, &camera, cell, sweep))
+        .collect();
+    let timed = time_interleaved(pool, scene, &requests, sweep.repeat)?;
     let mut timed = timed.into_iter();
     // 3. The rows in the sweep's order; peers timed each in its own block.
     let mut measured: Vec<Measured> = Vec::new();
@@ -161,25 +143,15 @@ pub fn measure_cell(
         ));
         let mut m = match entry {
             Entry::Algorithm(AlgorithmId::GpuRaster) => {
-                // One warm-up render (the GPU uploads the scene then), then the timed ones.
                 let request = algorithm_request(AlgorithmId::GpuRaster, &camera, cell, sweep);
-                let mut out = render_in(pool, scene, &request)?;
-                let mut times = Vec::new();
-                for _ in 0..sweep.repeat {
-                    out = render_in(pool, scene, &request)?;
-                    times.push(out.stats.time_ms.total);
-                }
-                algorithm_row(
-                    scene,
-                    (AlgorithmId::GpuRaster, cell),
-                    sweep,
-                    threads,
-                    out,
-                    times,
-                )
+                let (out, times) = time_interleaved(pool, scene, &[request], sweep.repeat)?
+                    .pop()
+                    .context("one timed render for gpu-raster")?;
+                let cell = (AlgorithmId::GpuRaster, cell);
+                algorithm_row(scene, cell, sweep, threads, out, times)
             }
             Entry::Algorithm(a) => {
-                let (_, out, times) = timed.next().context("one timed render per algorithm")?;
+                let (out, times) = timed.next().context("one timed render per algorithm")?;
                 algorithm_row(scene, (a, cell), sweep, threads, out, times)
             }
             Entry::Peer(p) => {
@@ -245,13 +217,30 @@ fn algorithm_request(
     }
 }
 
-fn render_in(
+/// Times `requests` interleaved: one warm-up render each (the GPU uploads
+/// the scene then), then `repeat` rounds of one render per request. Returns
+/// each request's last output and its round times.
+fn time_interleaved(
     pool: &rayon::ThreadPool,
     scene: &LoadedScene,
-    request: &RenderRequest,
-) -> Result<continuum::RenderOutput, CliError> {
-    pool.install(|| render(&scene.prepared, request))
-        .map_err(|e| CliError::Usage(format!("{e}")))
+    requests: &[RenderRequest],
+    repeat: u32,
+) -> Result<Vec<(continuum::RenderOutput, Vec<f64>)>, CliError> {
+    let render_one = |request: &RenderRequest| {
+        pool.install(|| render(&scene.prepared, request))
+            .map_err(|e| CliError::Usage(format!("{e}")))
+    };
+    let mut timed = requests
+        .iter()
+        .map(|r| Ok((render_one(r)?, Vec::new())))
+        .collect::<Result<Vec<_>, CliError>>()?;
+    for _ in 0..repeat {
+        for (request, (out, times)) in requests.iter().zip(&mut timed) {
+            *out = render_one(request)?;
+            times.push(out.stats.time_ms.total);
+        }
+    }
+    Ok(timed)
 }
 
 /// The row of an algorithm from its last render and the times of its rounds.
