@@ -180,16 +180,17 @@ impl SceneBvh {
         if self.cwbvh.nodes.is_empty() {
             return 0;
         }
-        let slabs = rays.map(|r| r.map(|(o, d)| SlabRay::new(o, d)));
-        let interval = PacketInterval::of(&slabs);
+        // Loops, not `map` closures: this is lane code (see `crate::simd`).
         // Absent lanes never enter a node.
-        let mut cull = rays.map(|r| {
-            if r.is_some() {
-                f32::INFINITY
-            } else {
-                f32::NEG_INFINITY
+        let (mut slabs, mut cull) = ([None; PACKET], [f32::NEG_INFINITY; PACKET]);
+        for l in 0..PACKET {
+            if let Some((origin, dir)) = rays[l] {
+                (slabs[l], cull[l]) = (Some(SlabRay::new(origin, dir)), f32::INFINITY);
             }
-        });
+        }
+        let interval = PacketInterval::of(&slabs);
+        // The packet's largest culling distance, renewed after each leaf.
+        let mut tmax = f32::INFINITY;
         let mut visited = 0u64;
         let bvh = &self.cwbvh;
         let mut state = bvh.new_traversal(Vec3A::from(first.1));
@@ -202,10 +203,7 @@ impl SceneBvh {
                 visited += 1;
                 let boxes = &self.child_boxes[node_index(bvh, node)];
                 let hits = match &interval {
-                    Some(interval) => {
-                        let tmax = cull.iter().fold(f32::NEG_INFINITY, |m, &c| m.max(c));
-                        interval.hits::<L>(boxes, tmax)
-                    }
+                    Some(interval) => interval.hits::<L>(boxes, tmax),
                     // A loop, not a closure: lane code must be inlined (see `crate::simd`).
                     None => {
                         let mut hits = 0;
@@ -221,6 +219,10 @@ impl SceneBvh {
             },
             {
                 leaf(state.primitive_id, &mut cull);
+                tmax = f32::NEG_INFINITY;
+                for &c in &cull {
+                    tmax = tmax.max(c);
+                }
             }
         );
         visited

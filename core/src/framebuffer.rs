@@ -89,35 +89,95 @@ impl Framebuffer {
         rects
     }
 
-    /// Copies a resolved tile into place.
-    pub(crate) fn store(&mut self, tile: &ResolvedTile) {
-        let [x0, y0, x1, y1] = tile.rect;
-        let w = (x1 - x0) as usize;
-        if !tile.sample_digest.is_empty() && self.sample_digest.is_empty() {
-            self.sample_digest = vec![0; self.color.len()];
+    /// Buffers for a render whose tiles will store every pixel
+    /// ([`Framebuffer::store_tiles`]): zeroed memory straight from the
+    /// allocator, so no pass over the image runs before the tiles fill it.
+    pub(crate) fn for_tiles(width: u32, height: u32) -> Framebuffer {
+        let n = width as usize * height as usize;
+        Framebuffer {
+            width,
+            height,
+            color: vec![[0; 4]; n],
+            depth: vec![0.0; n],
+            triangle_id: vec![0; n],
+            edge_evals: vec![0; n],
+            coverage_writes: vec![0; n],
+            sample_digest: Vec::new(),
+            blended: Vec::new(),
         }
-        if !tile.blended.is_empty() && self.blended.is_empty() {
-            self.blended = vec![0; self.color.len()];
-        }
-        for y in y0..y1 {
-            let src = (y - y0) as usize * w;
-            let dst = y as usize * self.width as usize + x0 as usize;
-            self.color[dst..dst + w].copy_from_slice(&tile.color[src..src + w]);
-            self.depth[dst..dst + w].copy_from_slice(&tile.depth[src..src + w]);
-            self.triangle_id[dst..dst + w].copy_from_slice(&tile.triangle_id[src..src + w]);
-            self.edge_evals[dst..dst + w].copy_from_slice(&tile.edge_evals[src..src + w]);
-            self.coverage_writes[dst..dst + w].copy_from_slice(&tile.coverage_writes[src..src + w]);
-            if !tile.sample_digest.is_empty() {
-                self.sample_digest[dst..dst + w].copy_from_slice(&tile.sample_digest[src..src + w]);
+    }
+
+    /// Copies resolved tiles into place, rows in parallel. The tiles must not
+    /// overlap; together they cover the image (checked by area).
+    pub(crate) fn store_tiles(&mut self, tiles: &[ResolvedTile]) {
+        let (width, height) = (self.width as usize, self.height as usize);
+        let area = |t: &ResolvedTile| {
+            let [x0, y0, x1, y1] = t.rect;
+            (x1 - x0) as usize * (y1 - y0) as usize
+        };
+        assert_eq!(
+            tiles.iter().map(area).sum::<usize>(),
+            width * height,
+            "the tiles must cover the image"
+        );
+        // Per row, the tiles holding it.
+        let mut rows: Vec<Vec<&ResolvedTile>> = vec![Vec::new(); height];
+        for t in tiles {
+            let [_, y0, _, y1] = t.rect;
+            for row in &mut rows[y0 as usize..y1 as usize] {
+                row.push(t);
             }
-            if !tile.blended.is_empty() {
-                self.blended[dst..dst + w].copy_from_slice(&tile.blended[src..src + w]);
-            }
         }
+        let n = width * height;
+        if tiles.iter().any(|t| !t.sample_digest.is_empty()) && self.sample_digest.is_empty() {
+            self.sample_digest = vec![0; n];
+        }
+        if tiles.iter().any(|t| !t.blended.is_empty()) && self.blended.is_empty() {
+            self.blended = vec![0; n];
+        }
+        store_rows(&mut self.color, width, &rows, |t| &t.color);
+        store_rows(&mut self.depth, width, &rows, |t| &t.depth);
+        store_rows(&mut self.triangle_id, width, &rows, |t| &t.triangle_id);
+        store_rows(&mut self.edge_evals, width, &rows, |t| &t.edge_evals);
+        store_rows(&mut self.coverage_writes, width, &rows, |t| {
+            &t.coverage_writes
+        });
+        store_rows(&mut self.sample_digest, width, &rows, |t| &t.sample_digest);
+        store_rows(&mut self.blended, width, &rows, |t| &t.blended);
     }
 }
 
-/// A tile's pixels after the resolve: what [`Framebuffer::store`] copies, plus
+/// One per-pixel buffer of [`Framebuffer::store_tiles`]: each row (in
+/// parallel) takes its span of every tile in `rows[y]` whose `field` is not
+/// empty. An empty `dst` (an optional buffer the render has not) stays so.
+fn store_rows<T: Copy + Send + Sync>(
+    dst: &mut [T],
+    width: usize,
+    rows: &[Vec<&ResolvedTile>],
+    field: impl Fn(&ResolvedTile) -> &[T] + Sync,
+) {
+    use rayon::prelude::*;
+    if dst.is_empty() {
+        return;
+    }
+    dst.par_chunks_mut(width)
+        .zip(rows)
+        .enumerate()
+        .for_each(|(y, (row, tiles))| {
+            for &t in tiles {
+                let src = field(t);
+                if src.is_empty() {
+                    continue;
+                }
+                let [x0, y0, x1, _] = t.rect.map(|v| v as usize);
+                let w = x1 - x0;
+                let start = (y - y0) * w;
+                row[x0..x1].copy_from_slice(&src[start..start + w]);
+            }
+        });
+}
+
+/// A tile's pixels after the resolve: what [`Framebuffer::store_tiles`] copies, plus
 /// what the resolve counted.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ResolvedTile {

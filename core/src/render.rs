@@ -3,6 +3,7 @@
 
 use std::time::Instant;
 
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::aa::AaMode;
@@ -132,7 +133,8 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
         request.height,
         scene.default_near,
     )?;
-    let mut fb = Framebuffer::new(request.width, request.height);
+    // Every path stores every pixel through `Framebuffer::store_tiles`.
+    let mut fb = Framebuffer::for_tiles(request.width, request.height);
     let mut stats = Stats::default();
     let pattern = request.aa.pattern();
 
@@ -193,8 +195,15 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
         );
     }
 
-    stats.edge_evaluations = fb.edge_evals.iter().map(|&e| u64::from(e)).sum();
-    stats.max_edge_evals_per_pixel = fb.edge_evals.iter().copied().max().unwrap_or(0);
+    (stats.edge_evaluations, stats.max_edge_evals_per_pixel) = fb
+        .edge_evals
+        .par_chunks(4096)
+        .map(|chunk| {
+            chunk.iter().fold((0u64, 0u32), |(sum, max), &e| {
+                (sum + u64::from(e), max.max(e))
+            })
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1.max(b.1)));
     let pixels = u64::from(request.width) * u64::from(request.height);
     stats.samples_per_pixel = request.aa.coverage_samples();
     stats.stored_samples_per_pixel = request.aa.stored_samples();

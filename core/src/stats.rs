@@ -98,31 +98,38 @@ pub struct Hashes {
 }
 
 impl Hashes {
+    /// xxh3 of the buffers' little-endian bytes, hashed in place (no copy of
+    /// the image) and side by side.
     pub fn of(fb: &Framebuffer) -> Hashes {
-        let ids: Vec<u8> = fb
-            .triangle_id
-            .iter()
-            .flat_map(|v| v.to_le_bytes())
-            .collect();
-        let color: Vec<u8> = fb.color.iter().flatten().copied().collect();
-        let hex = |bytes: &[u8]| format!("{:016x}", xxhash_rust::xxh3::xxh3_64(bytes));
-        let triangle_id = hex(&ids);
-        let samples = if fb.sample_digest.is_empty() {
-            triangle_id.clone()
-        } else {
-            let digests: Vec<u8> = fb
-                .sample_digest
-                .iter()
-                .flat_map(|v| v.to_le_bytes())
-                .collect();
-            hex(&digests)
-        };
+        let hex = |hash: u64| format!("{hash:016x}");
+        let ((triangle_id, color), digest) = rayon::join(
+            || {
+                rayon::join(
+                    || hash_le(&fb.triangle_id, u32::to_le_bytes),
+                    || xxhash_rust::xxh3::xxh3_64(fb.color.as_flattened()),
+                )
+            },
+            || (!fb.sample_digest.is_empty()).then(|| hash_le(&fb.sample_digest, u64::to_le_bytes)),
+        );
         Hashes {
-            triangle_id,
-            color: hex(&color),
-            samples,
+            triangle_id: hex(triangle_id),
+            color: hex(color),
+            samples: hex(digest.unwrap_or(triangle_id)),
         }
     }
+}
+
+/// xxh3 of `values` as little-endian bytes, streamed through a small buffer.
+fn hash_le<T: Copy, const N: usize>(values: &[T], bytes: fn(T) -> [u8; N]) -> u64 {
+    let mut hasher = xxhash_rust::xxh3::Xxh3::new();
+    let mut buffer = [0u8; 4096];
+    for chunk in values.chunks(buffer.len() / N) {
+        for (out, &v) in buffer.chunks_exact_mut(N).zip(chunk) {
+            out.copy_from_slice(&bytes(v));
+        }
+        hasher.update(&buffer[..chunk.len() * N]);
+    }
+    hasher.digest()
 }
 
 /// Counters of the hierarchical stages (binning, early-z, the BVH traversal).

@@ -136,6 +136,10 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
             }
         }
     }
+    if stored == 1 && pattern.coverage() == 1 && tile.fragments.is_empty() && !force_general() {
+        resolve_single(tile, view, shader, &mut out);
+        return out;
+    }
     let anti_aliased = pattern.coverage() > 1;
     // Layer by layer (contiguous, independent per pixel): the digest of every
     // sample's id (and mask), and whether a pixel's stored samples all hold
@@ -260,6 +264,47 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
     out
 }
 
+/// [`resolve_tile`] of a tile with one sample per pixel and no see-through
+/// fragments (no anti-aliasing, opaque surfaces): each pixel's colour is its
+/// sample's, exactly as the general path computes it, without its per-sample
+/// bookkeeping.
+fn resolve_single(tile: &TileBuffer, view: &View, shader: &Shader, out: &mut ResolvedTile) {
+    let [ox, oy] = tile.pattern.positions[0];
+    for y in tile.y0..tile.y1 {
+        for x in tile.x0..tile.x1 {
+            let i = tile.index(x, y);
+            let (id, at) = (tile.triangle_id[i], (x as f32 + ox, y as f32 + oy));
+            out.color[i] = if id == BACKGROUND {
+                // Only non-planar viewports have pixels without a ray.
+                match view.sphere.is_some() && view.ray(at.0, at.1).is_none() {
+                    true => OUTSIDE_VIEWPORT_COLOR,
+                    false => BACKGROUND_COLOR,
+                }
+            } else {
+                match view.ray(at.0, at.1) {
+                    Some(ray) => {
+                        out.shading_samples += 1;
+                        encode_rgb(shader.shade(id, at, ray, tile.depth[i], &mut out.effects))
+                    }
+                    None => encode_rgb(linear_rgb(OUTSIDE_VIEWPORT_COLOR)),
+                }
+            };
+        }
+    }
+}
+
+/// Tests: send every tile down the general path.
+#[cfg(test)]
+static FORCE_GENERAL: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+#[inline(always)]
+fn force_general() -> bool {
+    #[cfg(test)]
+    return FORCE_GENERAL.load(std::sync::atomic::Ordering::Relaxed);
+    #[cfg(not(test))]
+    false
+}
+
 /// The sum of what every coverage sample of pixel `i` (at `(x, y)`) sees, given
 /// the colours of its stored samples (`slot_color`).
 fn mixed_color(
@@ -320,4 +365,55 @@ fn mixed_color(
         };
     }
     sum
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::atomic::Ordering;
+
+    use super::FORCE_GENERAL;
+    use crate::{AlgorithmId, PreparedScene, RenderRequest, Viewport, render};
+
+    /// The single-sample path gives every pixel the colour the general path
+    /// gives it: lit, shadowed, mirrored and textured scenes; planar views and
+    /// the parabolic one (pixels without a ray); a rasterizer and the ray caster.
+    #[test]
+    fn the_single_sample_resolve_matches_the_general_one() {
+        for name in ["soup", "checker", "shadows", "mirror"] {
+            let path = format!("{}/../scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+            let scene = crate::scene::load_path(path.as_ref()).expect("built-in scene loads");
+            let scene = PreparedScene::new(scene);
+            let camera = scene.scene.first_camera();
+            let parabolic = crate::Camera {
+                viewport: Viewport::Parabolic,
+                ..camera.clone()
+            };
+            for (algorithm, camera) in [
+                (AlgorithmId::ThreeDBrute, &camera),
+                (AlgorithmId::Raycast, &camera),
+                (AlgorithmId::Raycast, &parabolic),
+            ] {
+                let request = RenderRequest {
+                    algorithm,
+                    oracles: None,
+                    camera: camera.clone(),
+                    width: 96,
+                    height: 64,
+                    aa: Default::default(),
+                    precision: Default::default(),
+                    texture_filter: Default::default(),
+                };
+                let colors = |general: bool| {
+                    FORCE_GENERAL.store(general, Ordering::Relaxed);
+                    let out = render(&scene, &request);
+                    FORCE_GENERAL.store(false, Ordering::Relaxed);
+                    let out = out.expect("renders");
+                    (out.framebuffer.color, out.stats.shading_samples)
+                };
+                let (fast, general) = (colors(false), colors(true));
+                assert!(fast.1 > 0, "{name} {algorithm}: something is shaded");
+                assert_eq!(fast, general, "{name} {algorithm} {}", camera.viewport);
+            }
+        }
+    }
 }

@@ -431,12 +431,15 @@ fn render_frusta<'a, T: crate::edge::Coverage>(
         )
         .collect();
     let mut pass = Pass::default();
-    for finished in done {
-        let (counters, nodes, setups) = finished.result;
-        pass.store(fb, &finished.map(|_| counters));
-        stats.bvh_nodes_visited += nodes;
-        stats.triangle_setups += setups;
-    }
+    pass.store(
+        fb,
+        done.into_iter().map(|finished| {
+            let (counters, nodes, setups) = finished.result;
+            stats.bvh_nodes_visited += nodes;
+            stats.triangle_setups += setups;
+            finished.map(|_| counters)
+        }),
+    );
     let (traversal, shading) = pass.split(start.elapsed().as_secs_f64() * 1e3);
     stats.time_ms.traversal = traversal;
     stats.time_ms.shading = shading;
@@ -541,15 +544,25 @@ pub(crate) struct Pass {
 }
 
 impl Pass {
-    /// Stores a finished tile's pixels and adds up its counters.
-    pub fn store(&mut self, fb: &mut Framebuffer, finished: &Finished<RasterCounters>) {
-        fb.store(&finished.resolved);
-        self.counters += finished.result;
-        self.histogram += finished.resolved.histogram;
-        self.shading_samples += finished.resolved.shading_samples;
-        self.effects.add(&finished.resolved.effects);
-        self.render_s += finished.render_s;
-        self.resolve_s += finished.resolve_s;
+    /// Adds up the finished tiles' counters and stores their pixels.
+    pub fn store(
+        &mut self,
+        fb: &mut Framebuffer,
+        finished: impl IntoIterator<Item = Finished<RasterCounters>>,
+    ) {
+        let resolved: Vec<ResolvedTile> = finished
+            .into_iter()
+            .map(|finished| {
+                self.counters += finished.result;
+                self.histogram += finished.resolved.histogram;
+                self.shading_samples += finished.resolved.shading_samples;
+                self.effects.add(&finished.resolved.effects);
+                self.render_s += finished.render_s;
+                self.resolve_s += finished.resolve_s;
+                finished.resolved
+            })
+            .collect();
+        fb.store_tiles(&resolved);
     }
 
     /// The pass's wall time split into rendering and shading (with the resolve)

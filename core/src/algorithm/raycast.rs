@@ -10,7 +10,8 @@ use rayon::prelude::*;
 
 use glam::Vec3;
 
-use super::{Pass, TileContext};
+use super::tiles::Placed;
+use super::{Pass, PixelRect, TileContext, setup3d};
 use crate::aa::SamplePattern;
 use crate::bvh::PACKET;
 use crate::camera::View;
@@ -49,13 +50,17 @@ pub(crate) fn render_raycast<'a, T: Coverage + Send + Sync>(
     setup: impl Fn(&'a [Vec3; 3], &'a View) -> Option<T> + Sync,
 ) -> Pass {
     let view = context.view;
-    // 1. Setup: the 3D edge functions of every drawable triangle for this view.
+    // 1. Setup: the 3D edge functions of every triangle with samples on
+    // screen, in BVH slot order, with the conservative screen box the
+    // rasterizers bound their search with: a ray tests a triangle only inside it.
     let start = Instant::now();
-    let setups: Vec<Option<T>> = scene
-        .slot_triangles
-        .par_iter()
-        .map(|&id| setup(&scene.triangles[id as usize], view))
-        .collect();
+    let setups = setup3d::setup_placed(
+        scene,
+        view,
+        context.pattern.span,
+        &scene.slot_triangles,
+        setup,
+    );
     stats.triangle_setups = setups.iter().filter(|s| s.is_some()).count() as u64;
     stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
 
@@ -78,10 +83,13 @@ pub(crate) fn render_raycast<'a, T: Coverage + Send + Sync>(
         )
         .collect();
     let mut pass = Pass::default();
-    for finished in done {
-        stats.bvh_nodes_visited += finished.result;
-        pass.store(fb, &finished.map(|_| Default::default()));
-    }
+    pass.store(
+        fb,
+        done.into_iter().map(|finished| {
+            stats.bvh_nodes_visited += finished.result;
+            finished.map(|_| Default::default())
+        }),
+    );
     let (traversal, shading) = pass.split(start.elapsed().as_secs_f64() * 1e3);
     stats.time_ms.traversal = traversal;
     stats.time_ms.shading = shading;
@@ -93,7 +101,7 @@ simd::dispatch! {
     fn cast_band<T: Coverage>(
         scene: &PreparedScene,
         view: &View,
-        setups: &[Option<T>],
+        setups: &[Option<Placed<T>>],
         tile: &mut TileBuffer,
     ) -> u64 => cast_band_on
 }
@@ -108,7 +116,7 @@ simd::dispatch! {
 fn cast_band_on<L: Lanes, T: Coverage>(
     scene: &PreparedScene,
     view: &View,
-    setups: &[Option<T>],
+    setups: &[Option<Placed<T>>],
     tile: &mut TileBuffer,
 ) -> u64 {
     let pattern = tile.pattern;
@@ -118,44 +126,61 @@ fn cast_band_on<L: Lanes, T: Coverage>(
     let mut slots = [[0u32; 8]; PACKET];
     for y in (tile.y0..tile.y1).step_by(BLOCK as usize) {
         for x in (tile.x0..tile.x1).step_by(BLOCK as usize) {
-            let block: [Option<(u32, u32)>; PACKET] = std::array::from_fn(|l| {
+            // The block's pixels inside the tile (`None` beyond its edges) and
+            // their buffer indices. Plain loops, no closures: this is lane code
+            // (see `crate::simd`).
+            let (mut block, mut index) = ([None; PACKET], [0; PACKET]);
+            for l in 0..PACKET {
                 let (px, py) = (x + l as u32 % BLOCK, y + l as u32 / BLOCK);
-                (px < tile.x1 && py < tile.y1).then_some((px, py))
-            });
-            let index = block.map(|p| p.map_or(0, |(px, py)| tile.index(px, py)));
+                if px < tile.x1 && py < tile.y1 {
+                    (block[l], index[l]) = (Some((px, py)), tile.index(px, py));
+                }
+            }
             for (s, &[ox, oy]) in pattern.positions[..stored].iter().enumerate() {
-                let points = block.map(|p| p.map(|(px, py)| (px as f32 + ox, py as f32 + oy)));
-                // No ray outside the viewport (the parabolic disc): background.
-                let rays = points.map(|p| p.and_then(|(xs, ys)| view.ray(xs, ys)));
-                // The packet's samples as two 8-lane tests (`present`: the rays cast).
+                // The packet's rays (none outside the viewport, e.g. the
+                // parabolic disc: background) and their samples as two 8-lane
+                // tests (`present`: the rays cast).
+                let mut rays = [None; PACKET];
                 let (mut xs, mut ys, mut present) =
                     ([[0.0; 8]; HALVES], [[0.0; 8]; HALVES], [0u8; HALVES]);
-                for (l, p) in points.iter().enumerate() {
-                    if let (Some(_), Some((px, py))) = (rays[l], *p) {
-                        (xs[l / 8][l % 8], ys[l / 8][l % 8]) = (px, py);
+                for l in 0..PACKET {
+                    let Some((px, py)) = block[l] else {
+                        continue;
+                    };
+                    let (sx, sy) = (px as f32 + ox, py as f32 + oy);
+                    rays[l] = view.ray(sx, sy);
+                    if rays[l].is_some() {
+                        (xs[l / 8][l % 8], ys[l / 8][l % 8]) = (sx, sy);
                         present[l / 8] |= 1 << (l % 8);
                     }
                 }
                 let mut best = [(f32::INFINITY, BACKGROUND, 0u32); PACKET];
-                // Every ray of the packet tests every triangle it reaches.
-                let (mut tested, mut covered) = (0u32, [0u32; PACKET]);
+                // Every ray of the packet tests every triangle it reaches
+                // whose screen box holds its pixel.
+                let (mut tested, mut covered) = ([0u32; PACKET], [0u32; PACKET]);
                 // See-through triangles leave fragments, as in the rasterizers'
                 // `TileBuffer::write`; the walk still culls beyond the nearest
                 // opaque hit, behind which no fragment shows.
                 let opacity = tile.opacity;
                 let fragments = &mut tile.fragments;
                 nodes += scene.bvh.walk_packet::<L>(&rays, |k, cull| {
-                    let Some(tri) = &setups[k as usize] else {
+                    let Some(item) = &setups[k as usize] else {
                         return;
                     };
-                    let id = scene.slot_triangles[k as usize];
+                    let (tri, id) = (&item.tri, item.id);
                     let see_through = is_see_through(opacity, id);
+                    let inside = block_mask(item.rect, x, y);
                     for half in 0..HALVES {
-                        if present[half] == 0 {
+                        let active = present[half] & (inside >> (8 * half)) as u8;
+                        if active == 0 {
                             continue;
                         }
-                        let (mut hits, depth) =
-                            tri.sample_points8::<L>(xs[half], ys[half], present[half]);
+                        let mut lanes = active;
+                        while lanes != 0 {
+                            tested[half * 8 + lanes.trailing_zeros() as usize] += 1;
+                            lanes &= lanes - 1;
+                        }
+                        let (mut hits, depth) = tri.sample_points8::<L>(xs[half], ys[half], active);
                         while hits != 0 {
                             let l = hits.trailing_zeros() as usize;
                             hits &= hits - 1;
@@ -173,14 +198,13 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                             }
                         }
                     }
-                    tested += 1;
                 });
                 for l in 0..PACKET {
                     if rays[l].is_none() {
                         continue;
                     }
                     let (i, j) = (index[l], s * pixels + index[l]);
-                    tile.edge_evals[i] += tested;
+                    tile.edge_evals[i] += tested[l];
                     tile.coverage_writes[j] = covered[l];
                     let (w, id, slot) = best[l];
                     (tile.depth[j], tile.triangle_id[j]) = (w, id);
@@ -207,7 +231,7 @@ fn cast_band_on<L: Lanes, T: Coverage>(
 /// once per triangle.
 #[inline(always)]
 fn stored_masks<L: Lanes, T: Coverage>(
-    setups: &[Option<T>],
+    setups: &[Option<Placed<T>>],
     slots: &[u32; 8],
     tile: &mut TileBuffer,
     (x, y): (u32, u32),
@@ -223,7 +247,7 @@ fn stored_masks<L: Lanes, T: Coverage>(
         let mask = match (0..s).find(|&t| id_at(tile, t) == id) {
             Some(t) => tile.masks[t * pixels + i],
             None => {
-                let Some(tri) = &setups[slots[s] as usize] else {
+                let Some(Placed { tri, .. }) = &setups[slots[s] as usize] else {
                     continue;
                 };
                 tile.edge_evals[i] += pattern.coverage() as u32;
@@ -270,7 +294,7 @@ fn coverage_mask<L: Lanes, T: Coverage>(tri: &T, pattern: &SamplePattern, x: u32
 fn lost_coverage<L: Lanes, T: Coverage>(
     scene: &PreparedScene,
     view: &View,
-    setups: &[Option<T>],
+    setups: &[Option<Placed<T>>],
     tile: &mut TileBuffer,
     (x, y): (u32, u32),
 ) -> u64 {
@@ -295,7 +319,7 @@ fn lost_coverage<L: Lanes, T: Coverage>(
         nodes += scene
             .bvh
             .walk(origin, direction, |k| match &setups[k as usize] {
-                Some(tri) if tri.covers8::<L>([xs; 8], [ys; 8]) & 1 == 1 => {
+                Some(Placed { tri, .. }) if tri.covers8::<L>([xs; 8], [ys; 8]) & 1 == 1 => {
                     covered |= 1 << c;
                     // Found: cull everything left.
                     f32::NEG_INFINITY
@@ -306,4 +330,60 @@ fn lost_coverage<L: Lanes, T: Coverage>(
     }
     tile.covered_any[i] = covered;
     nodes
+}
+
+/// The lanes of the 4×4 block at `(x, y)` whose pixel lies in `rect` (bit
+/// `l` for pixel `(x + l % 4, y + l / 4)`).
+#[inline(always)]
+fn block_mask(rect: PixelRect, x: u32, y: u32) -> u16 {
+    let columns = span_bits(rect.x0, rect.x1, x);
+    let rows = span_bits(rect.y0, rect.y1, y);
+    let mut mask = 0;
+    for r in 0..BLOCK {
+        if rows >> r & 1 == 1 {
+            mask |= columns << (BLOCK * r);
+        }
+    }
+    mask
+}
+
+/// Bits `i < BLOCK` with `from + i` in `lo..=hi`.
+#[inline(always)]
+fn span_bits(lo: u32, hi: u32, from: u32) -> u16 {
+    let start = lo.saturating_sub(from).min(BLOCK);
+    let end = (hi + 1).saturating_sub(from).min(BLOCK);
+    if start >= end {
+        return 0;
+    }
+    (1u16 << end) - (1u16 << start)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn block_masks_hold_exactly_the_pixels_in_the_rect() {
+        let mut rng = fastrand::Rng::with_seed(3);
+        for _ in 0..20_000 {
+            let (x0, y0) = (rng.u32(0..24), rng.u32(0..24));
+            let rect = PixelRect {
+                x0,
+                y0,
+                x1: x0 + rng.u32(0..8),
+                y1: y0 + rng.u32(0..8),
+            };
+            let (x, y) = (rng.u32(0..32), rng.u32(0..32));
+            let mask = block_mask(rect, x, y);
+            for l in 0..PACKET as u32 {
+                let (px, py) = (x + l % BLOCK, y + l / BLOCK);
+                let inside = (rect.x0..=rect.x1).contains(&px) && (rect.y0..=rect.y1).contains(&py);
+                assert_eq!(
+                    mask >> l & 1 == 1,
+                    inside,
+                    "{rect:?} at ({x}, {y}), lane {l}"
+                );
+            }
+        }
+    }
 }

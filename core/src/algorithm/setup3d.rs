@@ -57,12 +57,21 @@ fn setup_visible<'a, T: Send>(
     span: SampleSpan,
     setup: impl Fn(&'a [Vec3; 3], &'a View) -> Option<T> + Sync,
 ) -> Vec<Option<Placed<T>>> {
+    setup_placed(scene, view, span, &scene.drawable, setup)
+}
+
+/// The triangles `ids`, each set up by `setup` with its conservative screen
+/// box: one slot per id, in their order (an exactly sized, parallel collect:
+/// no chunks to concatenate); `None` for the ones off screen or edge-on.
+pub(crate) fn setup_placed<'a, T: Send>(
+    scene: &'a PreparedScene,
+    view: &'a View,
+    span: SampleSpan,
+    ids: &[u32],
+    setup: impl Fn(&'a [Vec3; 3], &'a View) -> Option<T> + Sync,
+) -> Vec<Option<Placed<T>>> {
     let boxes = ScreenBoxes::new(scene, view);
-    // One slot per drawable triangle (an exactly sized, parallel collect: no
-    // chunks to concatenate); `None` for the ones off screen or edge-on.
-    scene
-        .drawable
-        .par_iter()
+    ids.par_iter()
         .map(|&id| {
             let p = &scene.triangles[id as usize];
             let rect = boxes.rect(scene, id, view, span)?;

@@ -88,8 +88,6 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
         )
         .collect();
     let mut pass = Pass::default();
-    for finished in done {
-        pass.store(fb, &finished);
-    }
+    pass.store(fb, done);
     (pass, placed)
 }

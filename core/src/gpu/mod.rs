@@ -485,7 +485,7 @@ pub(crate) fn render_gpu_raster(
     stats.effects = resolved.effects.report(shader.plan(), &scene.scene);
     stats.coverage_histogram = resolved.histogram;
     stats.shading_samples = resolved.shading_samples;
-    fb.store(&resolved);
+    fb.store_tiles(std::slice::from_ref(&resolved));
     stats.time_ms.shading = start.elapsed().as_secs_f64() * 1e3;
     Ok(())
 }
