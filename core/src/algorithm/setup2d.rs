@@ -10,7 +10,9 @@ use super::PixelRect;
 use super::tiles::Placed;
 use crate::aa::SampleSpan;
 use crate::camera::View;
-use crate::clip::{GUARD_BAND, MAX_CLIPPED, clip_triangle, fixed_guard_band, pipeline_planes};
+use crate::clip::{
+    ClipPlane, GUARD_BAND, MAX_CLIPPED, clip_triangle, fixed_guard_band, pipeline_planes,
+};
 use crate::edge::{ScreenVertex, Triangle2D, Triangle2DFixed};
 use crate::prepared::PreparedScene;
 
@@ -45,7 +47,10 @@ pub(crate) fn setup_2d_fixed(
 
 /// Clips (the guard band `guard` in units of the half-extents), projects and
 /// fan-triangulates every drawable triangle; `make` sets up each piece and
-/// gives its pixel bounds `[min_x, min_y, max_x, max_y]`.
+/// gives its pixel bounds `[min_x, min_y, max_x, max_y]`. One slot per drawable
+/// triangle holds its first piece (an exactly sized, parallel collect written
+/// in place); the further pieces of the few triangles clipping cuts into
+/// several follow, set up again in a second, small pass.
 fn setup_pieces<T: Send>(
     scene: &PreparedScene,
     view: &View,
@@ -54,48 +59,66 @@ fn setup_pieces<T: Send>(
     make: impl Fn(&[ScreenVertex; 3]) -> Option<(T, [f32; 4])> + Sync,
 ) -> Vec<Option<Placed<T>>> {
     let planes = pipeline_planes(view, guard);
-    let affine = view.is_orthographic();
-    // Each triangle's pieces, in order (rayon collects the per-job lists
-    // into one exactly sized Vec: one copy, no growing and appending).
-    scene
+    let pieces = |id: u32| pieces_of(scene, view, span, &planes, &make, id);
+    let (mut placed, more): (Vec<Option<Placed<T>>>, Vec<bool>) = scene
         .drawable
         .par_iter()
-        .flat_map_iter(|&id| {
-            let mut pieces: [Option<Placed<T>>; MAX_CLIPPED - 2] = std::array::from_fn(|_| None);
-            // 1. Transform and clip.
-            let p = &scene.triangles[id as usize];
-            let cam = p.map(|v| view.to_camera_f64(v));
-            let Some(poly) = clip_triangle(cam, &planes) else {
-                return pieces.into_iter().flatten();
-            };
-            // 2. Project (the polygon has at most 8 vertices).
-            let mut screen = [ScreenVertex {
-                x: 0.0,
-                y: 0.0,
-                q: 0.0,
-            }; MAX_CLIPPED];
-            for (s, c) in screen.iter_mut().zip(poly.as_slice()) {
-                let (x, y) = view.project_f64(*c);
-                *s = ScreenVertex {
-                    x: x as f32,
-                    y: y as f32,
-                    q: (if affine { c.z } else { 1.0 / c.z }) as f32,
-                };
-            }
-            // 3. Fan-triangulate and set up each piece.
-            for k in 1..poly.len - 1 {
-                let Some((tri, [x0, y0, x1, y1])) = make(&[screen[0], screen[k], screen[k + 1]])
-                else {
-                    continue;
-                };
-                if let Some(rect) =
-                    PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height, span)
-                {
-                    pieces[k - 1] = Some(Placed { tri, rect, id });
-                }
-            }
-            pieces.into_iter().flatten()
+        .map(|&id| {
+            let mut pieces = pieces(id).into_iter().flatten();
+            (pieces.next(), pieces.next().is_some())
         })
-        .map(Some)
-        .collect()
+        .unzip();
+    let rest: Vec<Option<Placed<T>>> = scene
+        .drawable
+        .par_iter()
+        .zip(&more)
+        .filter(|&(_, &more)| more)
+        .flat_map_iter(|(&id, _)| pieces(id).into_iter().flatten().skip(1).map(Some))
+        .collect();
+    placed.extend(rest);
+    placed
+}
+
+/// The set-up pieces of triangle `id` after clipping and fan triangulation,
+/// in fan order (`None` where a piece has no samples on screen).
+fn pieces_of<T>(
+    scene: &PreparedScene,
+    view: &View,
+    span: SampleSpan,
+    planes: &[ClipPlane],
+    make: &impl Fn(&[ScreenVertex; 3]) -> Option<(T, [f32; 4])>,
+    id: u32,
+) -> [Option<Placed<T>>; MAX_CLIPPED - 2] {
+    let affine = view.is_orthographic();
+    let mut pieces: [Option<Placed<T>>; MAX_CLIPPED - 2] = std::array::from_fn(|_| None);
+    // 1. Transform and clip.
+    let p = &scene.triangles[id as usize];
+    let cam = p.map(|v| view.to_camera_f64(v));
+    let Some(poly) = clip_triangle(cam, planes) else {
+        return pieces;
+    };
+    // 2. Project (the polygon has at most 8 vertices).
+    let mut screen = [ScreenVertex {
+        x: 0.0,
+        y: 0.0,
+        q: 0.0,
+    }; MAX_CLIPPED];
+    for (s, c) in screen.iter_mut().zip(poly.as_slice()) {
+        let (x, y) = view.project_f64(*c);
+        *s = ScreenVertex {
+            x: x as f32,
+            y: y as f32,
+            q: (if affine { c.z } else { 1.0 / c.z }) as f32,
+        };
+    }
+    // 3. Fan-triangulate and set up each piece.
+    for k in 1..poly.len - 1 {
+        let Some((tri, [x0, y0, x1, y1])) = make(&[screen[0], screen[k], screen[k + 1]]) else {
+            continue;
+        };
+        if let Some(rect) = PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height, span) {
+            pieces[k - 1] = Some(Placed { tri, rect, id });
+        }
+    }
+    pieces
 }
