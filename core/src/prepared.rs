@@ -27,6 +27,11 @@ pub struct PreparedScene {
     /// Triangle id of each BVH primitive slot: `drawable[primitive_indices[slot]]`,
     /// so per-slot data sits in the order leaves read it.
     pub slot_triangles: Vec<u32>,
+    /// Per slot: its triangle's positions and mesh vertex indices, so a
+    /// per-view setup in slot order reads memory in order instead of
+    /// gathering from the mesh.
+    pub slot_corners: Vec<[Vec3; 3]>,
+    pub slot_vertices: Vec<[u32; 3]>,
     pub bounds: Bounds,
     /// Near distance for cameras that give none: 1e-3 of the bounding radius.
     pub default_near: f32,
@@ -64,11 +69,19 @@ impl PreparedScene {
             .collect();
         let face_normals = raw_normals.iter().map(|n| n.normalize_or_zero()).collect();
         let bvh = SceneBvh::build(&triangles, &drawable);
-        let slot_triangles = bvh
+        let slot_triangles: Vec<u32> = bvh
             .cwbvh
             .primitive_indices
             .iter()
             .map(|&k| drawable[k as usize])
+            .collect();
+        let slot_corners = slot_triangles
+            .par_iter()
+            .map(|&id| triangles[id as usize])
+            .collect();
+        let slot_vertices = slot_triangles
+            .par_iter()
+            .map(|&id| mesh.triangles[id as usize])
             .collect();
         let bounds = scene.bounds();
         let radius = if bounds.is_empty() {
@@ -104,6 +117,8 @@ impl PreparedScene {
             drawable,
             bvh,
             slot_triangles,
+            slot_corners,
+            slot_vertices,
             bounds,
             default_near: radius * 1e-3,
             scene,
@@ -122,7 +137,7 @@ impl PreparedScene {
             + self.triangles.len() * 36
             + self.face_normals.len() * 12
             + self.drawable.len() * 4
-            + self.slot_triangles.len() * 4
+            + self.slot_triangles.len() * (4 + 36 + 12)
             + self.triangle_opacity.len() * 4
             + self.bvh.cwbvh.nodes.len() * (80 + 192)
             + self.bvh.cwbvh.primitive_indices.len() * 4

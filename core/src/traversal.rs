@@ -277,14 +277,12 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
     /// Sets up the leaf's triangles and rasterizes them over the frustum.
     fn rasterize_leaf(&mut self, f: PixelRect, start: u32, count: u32) {
         let scene = self.scene;
-        for slot in start..start + count {
-            let k = scene.bvh.cwbvh.primitive_indices[slot as usize];
-            let id = scene.drawable[k as usize];
-            let p = &scene.triangles[id as usize];
-            let Some(rect) = self
-                .boxes
-                .rect(scene, id, self.view, self.tile.pattern.span)
-            else {
+        for slot in start as usize..(start + count) as usize {
+            // The slot-ordered copies: a leaf's triangles sit side by side.
+            let (p, id) = (&scene.slot_corners[slot], scene.slot_triangles[slot]);
+            let vertices = scene.slot_vertices[slot];
+            let span = self.tile.pattern.span;
+            let Some(rect) = self.boxes.rect_of(p, vertices, self.view, span) else {
                 continue;
             };
             let Some(clip) = rect.intersect(f) else {

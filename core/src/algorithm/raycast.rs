@@ -54,13 +54,7 @@ pub(crate) fn render_raycast<'a, T: Coverage + Send + Sync>(
     // screen, in BVH slot order, with the conservative screen box the
     // rasterizers bound their search with: a ray tests a triangle only inside it.
     let start = Instant::now();
-    let setups = setup3d::setup_placed(
-        scene,
-        view,
-        context.pattern.span,
-        &scene.slot_triangles,
-        setup,
-    );
+    let setups = setup3d::setup_slots(scene, view, context.pattern.span, setup);
     stats.triangle_setups = setups.iter().filter(|s| s.is_some()).count() as u64;
     stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
 

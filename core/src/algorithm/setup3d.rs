@@ -51,27 +51,44 @@ pub(crate) fn setup_homogeneous<'a>(
     setup_visible(scene, view, span, edge::setup_homogeneous)
 }
 
+/// Every BVH slot's triangle set up by `setup` with its conservative screen
+/// box, in slot order (from the scene's slot-ordered copies of positions and
+/// vertex indices: memory read in order); `None` for the ones off screen or
+/// edge-on.
+pub(crate) fn setup_slots<'a, T: Send>(
+    scene: &'a PreparedScene,
+    view: &'a View,
+    span: SampleSpan,
+    setup: impl Fn(&'a [Vec3; 3], &'a View) -> Option<T> + Sync,
+) -> Vec<Option<Placed<T>>> {
+    let boxes = ScreenBoxes::new(scene, view);
+    (scene.slot_corners.par_iter())
+        .zip(&scene.slot_vertices)
+        .zip(&scene.slot_triangles)
+        .map(|((p, &vertices), &id)| {
+            let rect = boxes.rect_of(p, vertices, view, span)?;
+            Some(Placed {
+                tri: setup(p, view)?,
+                rect,
+                id,
+            })
+        })
+        .collect()
+}
+
+/// Every drawable triangle set up by `setup` with its conservative screen
+/// box: one slot per triangle, in order (an exactly sized, parallel collect:
+/// no chunks to concatenate); `None` for the ones off screen or edge-on.
 fn setup_visible<'a, T: Send>(
     scene: &'a PreparedScene,
     view: &'a View,
     span: SampleSpan,
     setup: impl Fn(&'a [Vec3; 3], &'a View) -> Option<T> + Sync,
 ) -> Vec<Option<Placed<T>>> {
-    setup_placed(scene, view, span, &scene.drawable, setup)
-}
-
-/// The triangles `ids`, each set up by `setup` with its conservative screen
-/// box: one slot per id, in their order (an exactly sized, parallel collect:
-/// no chunks to concatenate); `None` for the ones off screen or edge-on.
-pub(crate) fn setup_placed<'a, T: Send>(
-    scene: &'a PreparedScene,
-    view: &'a View,
-    span: SampleSpan,
-    ids: &[u32],
-    setup: impl Fn(&'a [Vec3; 3], &'a View) -> Option<T> + Sync,
-) -> Vec<Option<Placed<T>>> {
     let boxes = ScreenBoxes::new(scene, view);
-    ids.par_iter()
+    scene
+        .drawable
+        .par_iter()
         .map(|&id| {
             let p = &scene.triangles[id as usize];
             let rect = boxes.rect(scene, id, view, span)?;
@@ -165,11 +182,27 @@ impl ScreenBoxes {
         view: &View,
         span: SampleSpan,
     ) -> Option<PixelRect> {
-        let p = &scene.triangles[id as usize];
+        let (p, vertices) = (
+            &scene.triangles[id as usize],
+            scene.scene.mesh.triangles[id as usize],
+        );
+        self.rect_of(p, vertices, view, span)
+    }
+
+    /// [`ScreenBoxes::rect`] of the triangle with positions `p` at mesh
+    /// vertices `vertices`.
+    #[inline]
+    pub(crate) fn rect_of(
+        &self,
+        p: &[Vec3; 3],
+        vertices: [u32; 3],
+        view: &View,
+        span: SampleSpan,
+    ) -> Option<PixelRect> {
         let Some(points) = &self.points else {
             return screen_rect(p, view, span);
         };
-        let points = scene.scene.mesh.triangles[id as usize].map(|v| points[v as usize]);
+        let points = vertices.map(|v| points[v as usize]);
         // Every vertex nearer than the bound: so is every point of the
         // triangle, which has no sample at `w ≥ near`.
         if points.iter().all(Option::is_none) {
