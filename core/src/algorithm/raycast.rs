@@ -10,8 +10,8 @@ use rayon::prelude::*;
 
 use glam::Vec3;
 
-use super::tiles::Placed;
-use super::{Pass, PixelRect, TileContext, setup3d};
+use super::setup3d::{self, SlotSetups};
+use super::{Pass, PixelRect, TileContext};
 use crate::aa::SamplePattern;
 use crate::bvh::PACKET;
 use crate::camera::View;
@@ -55,7 +55,7 @@ pub(crate) fn render_raycast<'a, T: Coverage + Send + Sync>(
     // rasterizers bound their search with: a ray tests a triangle only inside it.
     let start = Instant::now();
     let setups = setup3d::setup_slots(scene, view, context.pattern.span, setup);
-    stats.triangle_setups = setups.iter().filter(|s| s.is_some()).count() as u64;
+    stats.triangle_setups = setups.boxes.iter().filter(|s| s.is_some()).count() as u64;
     stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
 
     // 2. Rays per sample, bands of rows in parallel, each resolved by its worker.
@@ -95,7 +95,7 @@ simd::dispatch! {
     fn cast_band<T: Coverage>(
         scene: &PreparedScene,
         view: &View,
-        setups: &[Option<Placed<T>>],
+        setups: &SlotSetups<T>,
         tile: &mut TileBuffer,
     ) -> u64 => cast_band_on
 }
@@ -110,7 +110,7 @@ simd::dispatch! {
 fn cast_band_on<L: Lanes, T: Coverage>(
     scene: &PreparedScene,
     view: &View,
-    setups: &[Option<Placed<T>>],
+    setups: &SlotSetups<T>,
     tile: &mut TileBuffer,
 ) -> u64 {
     let pattern = tile.pattern;
@@ -148,6 +148,10 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                         present[l / 8] |= 1 << (l % 8);
                     }
                 }
+                let mut cast = 0u16;
+                for (half, &lanes) in present.iter().enumerate() {
+                    cast |= u16::from(lanes) << (8 * half);
+                }
                 let mut best = [(f32::INFINITY, BACKGROUND, 0u32); PACKET];
                 // Every ray of the packet tests every triangle it reaches
                 // whose screen box holds its pixel.
@@ -158,12 +162,18 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                 let opacity = tile.opacity;
                 let fragments = &mut tile.fragments;
                 nodes += scene.bvh.walk_packet::<L>(&rays, |k, cull| {
-                    let Some(item) = &setups[k as usize] else {
+                    // The box first: most leaf triangles miss a packet's block.
+                    let Some((rect, id)) = setups.boxes[k as usize] else {
                         return;
                     };
-                    let (tri, id) = (&item.tri, item.id);
+                    let inside = block_mask(rect, x, y);
+                    if cast & inside == 0 {
+                        return;
+                    }
+                    let Some(tri) = &setups.triangles[k as usize] else {
+                        return;
+                    };
                     let see_through = is_see_through(opacity, id);
-                    let inside = block_mask(item.rect, x, y);
                     for half in 0..HALVES {
                         let active = present[half] & (inside >> (8 * half)) as u8;
                         if active == 0 {
@@ -225,7 +235,7 @@ fn cast_band_on<L: Lanes, T: Coverage>(
 /// once per triangle.
 #[inline(always)]
 fn stored_masks<L: Lanes, T: Coverage>(
-    setups: &[Option<Placed<T>>],
+    setups: &SlotSetups<T>,
     slots: &[u32; 8],
     tile: &mut TileBuffer,
     (x, y): (u32, u32),
@@ -233,7 +243,7 @@ fn stored_masks<L: Lanes, T: Coverage>(
     let pattern = tile.pattern;
     let (i, pixels) = (tile.index(x, y), tile.pixels);
     let id_at = |tile: &TileBuffer, s: usize| tile.triangle_id[s * pixels + i];
-    for s in 0..pattern.stored {
+    for (s, &slot) in slots.iter().enumerate().take(pattern.stored) {
         let id = id_at(tile, s);
         if id == BACKGROUND {
             continue;
@@ -241,7 +251,7 @@ fn stored_masks<L: Lanes, T: Coverage>(
         let mask = match (0..s).find(|&t| id_at(tile, t) == id) {
             Some(t) => tile.masks[t * pixels + i],
             None => {
-                let Some(Placed { tri, .. }) = &setups[slots[s] as usize] else {
+                let Some(tri) = &setups.triangles[slot as usize] else {
                     continue;
                 };
                 tile.edge_evals[i] += pattern.coverage() as u32;
@@ -288,7 +298,7 @@ fn coverage_mask<L: Lanes, T: Coverage>(tri: &T, pattern: &SamplePattern, x: u32
 fn lost_coverage<L: Lanes, T: Coverage>(
     scene: &PreparedScene,
     view: &View,
-    setups: &[Option<Placed<T>>],
+    setups: &SlotSetups<T>,
     tile: &mut TileBuffer,
     (x, y): (u32, u32),
 ) -> u64 {
@@ -312,8 +322,8 @@ fn lost_coverage<L: Lanes, T: Coverage>(
         };
         nodes += scene
             .bvh
-            .walk(origin, direction, |k| match &setups[k as usize] {
-                Some(Placed { tri, .. }) if tri.covers8::<L>([xs; 8], [ys; 8]) & 1 == 1 => {
+            .walk(origin, direction, |k| match &setups.triangles[k as usize] {
+                Some(tri) if tri.covers8::<L>([xs; 8], [ys; 8]) & 1 == 1 => {
                     covered |= 1 << c;
                     // Found: cull everything left.
                     f32::NEG_INFINITY

@@ -51,29 +51,39 @@ pub(crate) fn setup_homogeneous<'a>(
     setup_visible(scene, view, span, edge::setup_homogeneous)
 }
 
+/// Per BVH slot, its triangle's conservative screen box and id, and apart
+/// from them its edge functions — so a ray caster reads the small box first
+/// and the edge functions only where the box holds its rays. `None` (in
+/// both) for a triangle off screen or edge-on.
+pub(crate) struct SlotSetups<T> {
+    pub boxes: Vec<Option<(PixelRect, u32)>>,
+    pub triangles: Vec<Option<T>>,
+}
+
 /// Every BVH slot's triangle set up by `setup` with its conservative screen
 /// box, in slot order (from the scene's slot-ordered copies of positions and
-/// vertex indices: memory read in order); `None` for the ones off screen or
-/// edge-on.
+/// vertex indices: memory read in order).
 pub(crate) fn setup_slots<'a, T: Send>(
     scene: &'a PreparedScene,
     view: &'a View,
     span: SampleSpan,
     setup: impl Fn(&'a [Vec3; 3], &'a View) -> Option<T> + Sync,
-) -> Vec<Option<Placed<T>>> {
+) -> SlotSetups<T> {
     let boxes = ScreenBoxes::new(scene, view);
-    (scene.slot_corners.par_iter())
+    let (boxes, triangles) = (scene.slot_corners.par_iter())
         .zip(&scene.slot_vertices)
         .zip(&scene.slot_triangles)
         .map(|((p, &vertices), &id)| {
-            let rect = boxes.rect_of(p, vertices, view, span)?;
-            Some(Placed {
-                tri: setup(p, view)?,
-                rect,
-                id,
-            })
+            let Some(rect) = boxes.rect_of(p, vertices, view, span) else {
+                return (None, None);
+            };
+            match setup(p, view) {
+                Some(tri) => (Some((rect, id)), Some(tri)),
+                None => (None, None),
+            }
         })
-        .collect()
+        .unzip();
+    SlotSetups { boxes, triangles }
 }
 
 /// Every drawable triangle set up by `setup` with its conservative screen
