@@ -157,11 +157,11 @@ impl SceneBvh {
         visited
     }
 
-    /// [`SceneBvh::walk`] for a packet of up to [`PACKET`] rays (`None` lanes
-    /// are absent): a node is entered when any ray may meet it before its own
-    /// culling distance, so every ray reaches every node its single walk would
-    /// (front to back in the first present ray's order). Rays from one origin
-    /// (every perspective and spherical view) are tested together by
+    /// [`SceneBvh::walk`] for a packet of up to [`PACKET`] rays (absent lanes
+    /// take no part): a node is entered when any ray may meet it before its
+    /// own culling distance, so every ray reaches every node its single walk
+    /// would (front to back in the first present ray's order). Rays from one
+    /// origin (every perspective and spherical view) are tested together by
     /// [`PacketInterval`], one 8-lane test per node for the whole packet;
     /// others ray by ray. `leaf(slot, cull)` is called for each primitive slot
     /// of every leaf the packet reaches and updates each lane's culling
@@ -171,29 +171,51 @@ impl SceneBvh {
     #[inline(always)]
     pub fn walk_packet<L: Lanes>(
         &self,
-        rays: &[Option<(Vec3, Vec3)>; PACKET],
+        rays: PacketRays,
         mut leaf: impl FnMut(u32, &mut [f32; PACKET]),
     ) -> u64 {
-        let Some(first) = rays.iter().flatten().next() else {
-            return 0;
-        };
         if self.cwbvh.nodes.is_empty() {
             return 0;
         }
         // Loops, not `map` closures: this is lane code (see `crate::simd`).
         // Absent lanes never enter a node.
         let (mut slabs, mut cull) = ([None; PACKET], [f32::NEG_INFINITY; PACKET]);
-        for l in 0..PACKET {
-            if let Some((origin, dir)) = rays[l] {
-                (slabs[l], cull[l]) = (Some(SlabRay::new(origin, dir)), f32::INFINITY);
+        let (interval, first) = match rays {
+            PacketRays::OneOrigin {
+                origin,
+                directions,
+                present,
+            } => {
+                if present == 0 {
+                    return 0;
+                }
+                for (l, c) in cull.iter_mut().enumerate() {
+                    if present >> l & 1 == 1 {
+                        *c = f32::INFINITY;
+                    }
+                }
+                let l = present.trailing_zeros() as usize;
+                let first = Vec3::new(directions[0][l], directions[1][l], directions[2][l]);
+                let interval = PacketInterval::of_directions::<L>(origin, &directions, present);
+                (Some(interval), first)
             }
-        }
-        let interval = PacketInterval::of(&slabs);
+            PacketRays::Rays(rays) => {
+                let Some(&(_, first)) = rays.iter().flatten().next() else {
+                    return 0;
+                };
+                for l in 0..PACKET {
+                    if let Some((origin, dir)) = rays[l] {
+                        (slabs[l], cull[l]) = (Some(SlabRay::new(origin, dir)), f32::INFINITY);
+                    }
+                }
+                (PacketInterval::of(&slabs), first)
+            }
+        };
         // The packet's largest culling distance, renewed after each leaf.
         let mut tmax = f32::INFINITY;
         let mut visited = 0u64;
         let bvh = &self.cwbvh;
-        let mut state = bvh.new_traversal(Vec3A::from(first.1));
+        let mut state = bvh.new_traversal(Vec3A::from(first));
         let mut node: &CwBvhNode;
         obvhs::traverse!(
             bvh,
@@ -274,7 +296,57 @@ pub struct PacketInterval {
     inv_max: [f32; 3],
 }
 
+/// The rays of a packet for [`SceneBvh::walk_packet`].
+#[derive(Clone, Copy, Debug)]
+pub enum PacketRays<'r> {
+    /// Rays from `origin` along `directions[axis][lane]`; lanes outside
+    /// `present` (bit per lane) take no part and may hold anything.
+    OneOrigin {
+        origin: Vec3,
+        directions: [[f32; PACKET]; 3],
+        present: u16,
+    },
+    /// One ray per lane (`None`: absent), any origins.
+    Rays(&'r [Option<(Vec3, Vec3)>; PACKET]),
+}
+
 impl PacketInterval {
+    /// The interval of rays from `origin` along `directions[axis][lane]`
+    /// (lanes in `present`, at least one): the same bounds as [`PacketInterval::of`]
+    /// on their [`SlabRay`]s, with the reciprocals taken eight lanes at a
+    /// time (IEEE division, so each lane rounds as the scalar one).
+    #[inline(always)]
+    pub fn of_directions<L: Lanes>(
+        origin: Vec3,
+        directions: &[[f32; PACKET]; 3],
+        present: u16,
+    ) -> PacketInterval {
+        let (origin_lo, origin_hi) = padded_origin(origin);
+        let first = present.trailing_zeros() as usize;
+        let (mut inv_min, mut inv_max) = ([0.0; 3], [0.0; 3]);
+        for a in 0..3 {
+            // Absent lanes repeat the first present one: no effect on min/max.
+            let mut safe = [[0.0; 8]; PACKET / 8];
+            for l in 0..PACKET {
+                let d = directions[a][if present >> l & 1 == 1 { l } else { first }];
+                safe[l / 8][l % 8] = safe_direction(d);
+            }
+            let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+            for half in safe {
+                for inv in (L::splat(1.0) / L::from_array(half)).to_array() {
+                    (lo, hi) = (lo.min(inv), hi.max(inv));
+                }
+            }
+            (inv_min[a], inv_max[a]) = (lo, hi);
+        }
+        PacketInterval {
+            origin_lo,
+            origin_hi,
+            inv_min,
+            inv_max,
+        }
+    }
+
     /// `None` unless every present ray has the same origin (and some ray is present).
     pub fn of(slabs: &[Option<SlabRay>]) -> Option<PacketInterval> {
         let mut present = slabs.iter().flatten();
@@ -347,22 +419,42 @@ pub struct SlabRay {
 /// gives an interval of ±10³⁰, one outside never enters) and never forms 0·∞.
 const TINY_DIRECTION: f32 = 1e-30;
 
+/// A direction component as the slab tests use it: at least
+/// [`TINY_DIRECTION`] in magnitude, with its sign.
+#[inline(always)]
+fn safe_direction(d: f32) -> f32 {
+    if d.abs() < TINY_DIRECTION {
+        TINY_DIRECTION.copysign(d)
+    } else {
+        d
+    }
+}
+
+/// The origin moved by its own rounding pad, for lower bounds and for upper
+/// bounds (see [`SlabRay`]).
+#[inline(always)]
+fn padded_origin(origin: Vec3) -> ([f32; 3], [f32; 3]) {
+    let pad = origin.abs().max_element() * BOX_PAD;
+    (
+        (origin + Vec3::splat(pad)).to_array(),
+        (origin - Vec3::splat(pad)).to_array(),
+    )
+}
+
 impl SlabRay {
     pub fn new(origin: Vec3, dir: Vec3) -> SlabRay {
-        let pad = origin.abs().max_element() * BOX_PAD;
-        let safe = dir.to_array().map(|d| {
-            if d.abs() < TINY_DIRECTION {
-                TINY_DIRECTION.copysign(d)
-            } else {
-                d
-            }
-        });
+        let (origin_lo, origin_hi) = padded_origin(origin);
+        let d = dir.to_array();
         SlabRay {
             origin: origin.to_array(),
-            dir: dir.to_array(),
-            inv: safe.map(|d| 1.0 / d),
-            origin_lo: (origin + Vec3::splat(pad)).to_array(),
-            origin_hi: (origin - Vec3::splat(pad)).to_array(),
+            dir: d,
+            inv: [
+                1.0 / safe_direction(d[0]),
+                1.0 / safe_direction(d[1]),
+                1.0 / safe_direction(d[2]),
+            ],
+            origin_lo,
+            origin_hi,
         }
     }
 
@@ -457,6 +549,54 @@ mod tests {
             kept_extra < 4000 * 8 - met,
             "the interval test kept every box"
         );
+    }
+
+    /// The interval built from directions eight lanes at a time is the one
+    /// built from the rays' own slab rays, field for field, on both lane
+    /// types: random packets with absent lanes, tiny and zero components.
+    #[test]
+    fn the_interval_from_directions_is_the_interval_of_the_rays() {
+        let mut rng = fastrand::Rng::with_seed(12);
+        for case in 0..3000 {
+            let origin = Vec3::new(rng.f32() - 0.5, rng.f32() * 1e3, -rng.f32()) * 7.0;
+            let present = (rng.u32(..) as u16) | 1 << rng.usize(0..PACKET);
+            let mut directions = [[0.0; PACKET]; 3];
+            for axis in &mut directions {
+                for d in axis.iter_mut() {
+                    *d = match rng.u8(0..8) {
+                        0 => 0.0,
+                        1 => -1e-31,
+                        _ => rng.f32() * 4.0 - 2.0,
+                    };
+                }
+            }
+            let slabs: Vec<Option<SlabRay>> = (0..PACKET)
+                .map(|l| {
+                    let d = Vec3::new(directions[0][l], directions[1][l], directions[2][l]);
+                    (present >> l & 1 == 1).then(|| SlabRay::new(origin, d))
+                })
+                .collect();
+            let expected = PacketInterval::of(&slabs).expect("one origin");
+            let fields = |i: PacketInterval| (i.origin_lo, i.origin_hi, i.inv_min, i.inv_max);
+            let portable = PacketInterval::of_directions::<Portable>(origin, &directions, present);
+            assert_eq!(fields(portable), fields(expected), "case {case}");
+            #[cfg(target_arch = "x86_64")]
+            if crate::simd::cpu_has_avx2() {
+                // SAFETY: this CPU has AVX2.
+                let avx2 = unsafe { of_directions_avx2(origin, &directions, present) };
+                assert_eq!(fields(avx2), fields(expected), "case {case} (AVX2)");
+            }
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn of_directions_avx2(
+        origin: Vec3,
+        directions: &[[f32; PACKET]; 3],
+        present: u16,
+    ) -> PacketInterval {
+        PacketInterval::of_directions::<crate::simd::Avx2>(origin, directions, present)
     }
 
     /// Rays from different origins (orthographic views) are walked ray by ray.

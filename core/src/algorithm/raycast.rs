@@ -13,7 +13,7 @@ use glam::Vec3;
 use super::setup3d::{self, SlotSetups};
 use super::{Pass, PixelRect, TileContext};
 use crate::aa::SamplePattern;
-use crate::bvh::PACKET;
+use crate::bvh::{PACKET, PacketRays};
 use crate::camera::View;
 use crate::edge::Coverage;
 use crate::framebuffer::{
@@ -116,6 +116,9 @@ fn cast_band_on<L: Lanes, T: Coverage>(
     let pattern = tile.pattern;
     let (stored, pixels) = (pattern.stored, tile.pixels);
     let mut nodes = 0;
+    // Planar perspective views: every ray leaves the eye along
+    // `View::direction`, computed here for the packet eight lanes at a time.
+    let perspective = view.sphere.is_none() && !view.is_orthographic();
     // Per lane: the BVH slot of each stored sample's triangle (CSAA).
     let mut slots = [[0u32; 8]; PACKET];
     for y in (tile.y0..tile.y1).step_by(BLOCK as usize) {
@@ -142,16 +145,28 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                         continue;
                     };
                     let (sx, sy) = (px as f32 + ox, py as f32 + oy);
-                    rays[l] = view.ray(sx, sy);
-                    if rays[l].is_some() {
-                        (xs[l / 8][l % 8], ys[l / 8][l % 8]) = (sx, sy);
-                        present[l / 8] |= 1 << (l % 8);
+                    if !perspective {
+                        rays[l] = view.ray(sx, sy);
+                        if rays[l].is_none() {
+                            continue;
+                        }
                     }
+                    (xs[l / 8][l % 8], ys[l / 8][l % 8]) = (sx, sy);
+                    present[l / 8] |= 1 << (l % 8);
                 }
                 let mut cast = 0u16;
                 for (half, &lanes) in present.iter().enumerate() {
                     cast |= u16::from(lanes) << (8 * half);
                 }
+                let packet = if perspective {
+                    PacketRays::OneOrigin {
+                        origin: view.eye,
+                        directions: directions_lanes::<L>(view, &xs, &ys),
+                        present: cast,
+                    }
+                } else {
+                    PacketRays::Rays(&rays)
+                };
                 let mut best = [(f32::INFINITY, BACKGROUND, 0u32); PACKET];
                 // Every ray of the packet tests every triangle it reaches
                 // whose screen box holds its pixel.
@@ -161,7 +176,7 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                 // opaque hit, behind which no fragment shows.
                 let opacity = tile.opacity;
                 let fragments = &mut tile.fragments;
-                nodes += scene.bvh.walk_packet::<L>(&rays, |k, cull| {
+                nodes += scene.bvh.walk_packet::<L>(packet, |k, cull| {
                     // The box first: most leaf triangles miss a packet's block.
                     let Some((rect, id)) = setups.boxes[k as usize] else {
                         return;
@@ -204,7 +219,7 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                     }
                 });
                 for l in 0..PACKET {
-                    if rays[l].is_none() {
+                    if cast >> l & 1 == 0 {
                         continue;
                     }
                     let (i, j) = (index[l], s * pixels + index[l]);
@@ -228,6 +243,27 @@ fn cast_band_on<L: Lanes, T: Coverage>(
         }
     }
     nodes
+}
+
+/// `View::direction` of the packet's samples `(xs, ys)`, per axis and lane:
+/// `(d0 + x·dx) + y·dy` per component in the order the scalar form rounds
+/// (no FMA), so each lane equals it bit for bit.
+#[inline(always)]
+fn directions_lanes<L: Lanes>(
+    view: &View,
+    xs: &[[f32; 8]; HALVES],
+    ys: &[[f32; 8]; HALVES],
+) -> [[f32; PACKET]; 3] {
+    let (d0, dx, dy) = (view.d0.to_array(), view.dx.to_array(), view.dy.to_array());
+    let mut directions = [[0.0; PACKET]; 3];
+    for half in 0..HALVES {
+        let (x, y) = (L::from_array(xs[half]), L::from_array(ys[half]));
+        for a in 0..3 {
+            let d = L::splat(d0[a]) + L::splat(dx[a]) * x + L::splat(dy[a]) * y;
+            directions[a][half * 8..half * 8 + 8].copy_from_slice(&d.to_array());
+        }
+    }
+    directions
 }
 
 /// CSAA: the coverage mask of each triangle the stored rays of pixel `(x, y)`
@@ -365,6 +401,41 @@ fn span_bits(lo: u32, hi: u32, from: u32) -> u16 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The packet's directions, eight lanes at a time, are `View::direction`
+    /// bit for bit (portable lanes; the AVX2 ones round alike, see `simd`).
+    #[test]
+    fn packet_directions_are_the_views_directions() {
+        let mut rng = fastrand::Rng::with_seed(4);
+        for case in 0..200 {
+            let camera = crate::Camera {
+                name: "test".into(),
+                eye: glam::Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 100.0 - 50.0,
+                target: glam::Vec3::new(rng.f32(), rng.f32(), rng.f32()),
+                up: glam::Vec3::Y,
+                viewport: crate::Viewport::Perspective {
+                    fov_y_deg: 10.0 + rng.f32() * 150.0,
+                },
+                near: None,
+            };
+            let view = View::new(&camera, 1920, 1080, 1e-3).expect("a valid view");
+            let (mut xs, mut ys) = ([[0.0; 8]; HALVES], [[0.0; 8]; HALVES]);
+            for l in 0..PACKET {
+                xs[l / 8][l % 8] = rng.f32() * 1921.0;
+                ys[l / 8][l % 8] = rng.f32() * 1081.0;
+            }
+            let lanes = directions_lanes::<crate::simd::Portable>(&view, &xs, &ys);
+            for l in 0..PACKET {
+                let d = view.direction(xs[l / 8][l % 8], ys[l / 8][l % 8]);
+                let lane = [lanes[0][l], lanes[1][l], lanes[2][l]];
+                assert_eq!(
+                    lane.map(f32::to_bits),
+                    d.to_array().map(f32::to_bits),
+                    "case {case}"
+                );
+            }
+        }
+    }
 
     #[test]
     fn block_masks_hold_exactly_the_pixels_in_the_rect() {
