@@ -159,6 +159,21 @@ pub(crate) fn image_extent(view: &View) -> (f32, f32) {
     (view.width as f32 + 1.0, view.height as f32 + 1.0)
 }
 
+/// A vector's components along the sample generator: `[n·d0, n·dx, n·dy]`.
+#[inline(always)]
+fn along(n: Vec3, view: &View) -> Linear {
+    [n.dot(view.d0), n.dot(view.dx), n.dot(view.dy)]
+}
+
+/// The perspective edge function of edge `(a, b)` (eye-relative vertices),
+/// oriented by `sign`, and the bound of its coefficients' f32 error: 8ε of
+/// `|m| ⊗ |u|` along `d_abs`, the largest sample direction.
+#[inline(always)]
+fn perspective_edge(a: Vec3, b: Vec3, sign: f32, d_abs: Vec3, view: &View) -> (Linear, f32) {
+    let error = 8.0 * EPS * abs_cross((a + b) * 0.5, a - b).dot(d_abs);
+    (along(edge_normal(a, b) * sign, view), error)
+}
+
 impl<'a> Triangle3D<'a> {
     /// Paper §3.2 setup: three edge normals, their derivatives along the sample
     /// generator, and the triangle's volume as seen from the eye. `None` when the
@@ -187,25 +202,22 @@ impl<'a> Triangle3D<'a> {
             exact::dot(&exact::cross(v[1], v[2]), v[0]).signum()
         })?;
         let sign = if positive { 1.0 } else { -1.0 };
-        let along = |n: Vec3| [n.dot(view.d0), n.dot(view.dx), n.dot(view.dy)];
         // 4. Edge i is opposite vertex i: (p[i+1], p[i+2]); its f32 error is at
         //    most 8ε of |m| ⊗ |u| along the largest sample direction.
+        //    (Three calls, not an array `map`: closures there were compiled as calls.)
         let (x_max, y_max) = image_extent(view);
         let d_abs = view.d0.abs() + view.dx.abs() * x_max + view.dy.abs() * y_max;
-        let mut coefficient_error = [0.0; 3];
-        let edges = [0, 1, 2].map(|i| {
-            let (a, b) = (c[(i + 1) % 3], c[(i + 2) % 3]);
-            coefficient_error[i] = 8.0 * EPS * abs_cross((a + b) * 0.5, a - b).dot(d_abs);
-            along(edge_normal(a, b) * sign)
-        });
+        let (e0, r0) = perspective_edge(c[1], c[2], sign, d_abs, view);
+        let (e1, r1) = perspective_edge(c[2], c[0], sign, d_abs, view);
+        let (e2, r2) = perspective_edge(c[0], c[1], sign, d_abs, view);
         // w = |D|/(N·d) is homogeneous of degree 1 in the vertices: undo the scale.
         Triangle3D::from_linear(
-            edges,
-            along(normal * sign),
+            [e0, e1, e2],
+            along(normal * sign, view),
             [d.abs() * scale, 0.0, 0.0],
             w,
             view,
-            coefficient_error,
+            [r0, r1, r2],
             ExactEdges::new(ExactForm::Perspective, p, view, !positive),
         )
     }
