@@ -282,7 +282,7 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
             let (p, id) = (&scene.slot_corners[slot], scene.slot_triangles[slot]);
             let vertices = scene.slot_vertices[slot];
             let span = self.tile.pattern.span;
-            let Some(rect) = self.boxes.rect_of(p, vertices, self.view, span) else {
+            let Some(rect) = self.boxes.rect(p, vertices, self.view, span) else {
                 continue;
             };
             let Some(clip) = rect.intersect(f) else {

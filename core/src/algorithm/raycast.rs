@@ -136,10 +136,9 @@ fn cast_band_on<L: Lanes, T: Coverage>(
             for (s, &[ox, oy]) in pattern.positions[..stored].iter().enumerate() {
                 // The packet's rays (none outside the viewport, e.g. the
                 // parabolic disc: background) and their samples as two 8-lane
-                // tests (`present`: the rays cast).
+                // tests (`cast`: bit per lane whose ray is cast).
                 let mut rays = [None; PACKET];
-                let (mut xs, mut ys, mut present) =
-                    ([[0.0; 8]; HALVES], [[0.0; 8]; HALVES], [0u8; HALVES]);
+                let (mut xs, mut ys, mut cast) = ([[0.0; 8]; HALVES], [[0.0; 8]; HALVES], 0u16);
                 for l in 0..PACKET {
                     let Some((px, py)) = block[l] else {
                         continue;
@@ -152,11 +151,7 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                         }
                     }
                     (xs[l / 8][l % 8], ys[l / 8][l % 8]) = (sx, sy);
-                    present[l / 8] |= 1 << (l % 8);
-                }
-                let mut cast = 0u16;
-                for (half, &lanes) in present.iter().enumerate() {
-                    cast |= u16::from(lanes) << (8 * half);
+                    cast |= 1 << l;
                 }
                 let packet = if perspective {
                     PacketRays::OneOrigin {
@@ -190,7 +185,7 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                     };
                     let see_through = is_see_through(opacity, id);
                     for half in 0..HALVES {
-                        let active = present[half] & (inside >> (8 * half)) as u8;
+                        let active = ((cast & inside) >> (8 * half)) as u8;
                         if active == 0 {
                             continue;
                         }

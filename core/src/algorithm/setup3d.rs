@@ -74,11 +74,9 @@ pub(crate) fn setup_slots<'a, T: Send>(
         .zip(&scene.slot_vertices)
         .zip(&scene.slot_triangles)
         .map(|((p, &vertices), &id)| {
-            let Some(rect) = boxes.rect_of(p, vertices, view, span) else {
-                return (None, None);
-            };
-            match setup(p, view) {
-                Some(tri) => (Some((rect, id)), Some(tri)),
+            let rect = boxes.rect(p, vertices, view, span);
+            match rect.and_then(|rect| Some((rect, setup(p, view)?))) {
+                Some((rect, tri)) => (Some((rect, id)), Some(tri)),
                 None => (None, None),
             }
         })
@@ -101,7 +99,7 @@ fn setup_visible<'a, T: Send>(
         .par_iter()
         .map(|&id| {
             let p = &scene.triangles[id as usize];
-            let rect = boxes.rect(scene, id, view, span)?;
+            let rect = boxes.rect(p, scene.scene.mesh.triangles[id as usize], view, span)?;
             Some(Placed {
                 tri: setup(p, view)?,
                 rect,
@@ -183,26 +181,10 @@ impl ScreenBoxes {
         ScreenBoxes { points }
     }
 
-    /// [`screen_rect`] of triangle `id` (`scene.triangles[id]` are its mesh
-    /// vertices' positions, so the points are the ones it would compute).
-    pub(crate) fn rect(
-        &self,
-        scene: &PreparedScene,
-        id: u32,
-        view: &View,
-        span: SampleSpan,
-    ) -> Option<PixelRect> {
-        let (p, vertices) = (
-            &scene.triangles[id as usize],
-            scene.scene.mesh.triangles[id as usize],
-        );
-        self.rect_of(p, vertices, view, span)
-    }
-
-    /// [`ScreenBoxes::rect`] of the triangle with positions `p` at mesh
-    /// vertices `vertices`.
+    /// [`screen_rect`] of the triangle with positions `p` at mesh vertices
+    /// `vertices` (planar views read the vertices' projections).
     #[inline]
-    pub(crate) fn rect_of(
+    pub(crate) fn rect(
         &self,
         p: &[Vec3; 3],
         vertices: [u32; 3],
