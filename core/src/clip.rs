@@ -62,6 +62,13 @@ impl ClipPlane {
         v.dot(self.k) - self.offset
     }
 
+    /// Whether `v` is on this plane's kept side (`distance ≥ 0`, the test
+    /// [`clip_triangle`] makes).
+    #[inline]
+    pub(crate) fn keeps(&self, v: DVec3) -> bool {
+        self.distance(v) >= 0.0
+    }
+
     /// The point where the segment from `vin` (inside, distance `din`) to
     /// `vout` (outside, `dout`) crosses the plane, with its `axis` coordinate
     /// solved from the others so the point is on the plane.

@@ -72,6 +72,56 @@ struct NodeBox {
     min_w: f32,
 }
 
+/// A frustum: its pixels, the four side planes through their borders, and
+/// its centre ray — computed once when the frustum is made, not at every node
+/// it meets.
+#[derive(Clone, Copy, Debug)]
+struct Frustum {
+    rect: PixelRect,
+    /// Each side plane as `n·(p − eye) ≥ offset` (through the eye under
+    /// perspective, parallel to the view axis under orthographic projection).
+    planes: [(Vec3A, f32); 4],
+    /// The ray through the rect's centre (for `split_frustum`).
+    centre: SlabRay,
+}
+
+impl Frustum {
+    fn new(rect: PixelRect, v: &View) -> Frustum {
+        let (fw, right, up) = (v.forward, v.right, v.up);
+        // Image x of a camera-space point is (x/w / half_x + 1)·W/2 (orthographic:
+        // x instead of x/w); border lines at the rect's pixel edges (half a pixel
+        // beyond its outermost samples).
+        let kx = |x: u32| (2.0 * x as f32 / v.width as f32 - 1.0) * v.half_x;
+        let ky = |y: u32| (1.0 - 2.0 * y as f32 / v.height as f32) * v.half_y;
+        let (left, right_border) = (kx(rect.x0), kx(rect.x1 + 1));
+        let (top, bottom) = (ky(rect.y0), ky(rect.y1 + 1));
+        let planes = if v.is_orthographic() {
+            [
+                (right, left),
+                (-right, -right_border),
+                (-up, -top),
+                (up, bottom),
+            ]
+        } else {
+            [
+                (right - fw * left, 0.0),
+                (fw * right_border - right, 0.0),
+                (fw * top - up, 0.0),
+                (up - fw * bottom, 0.0),
+            ]
+        };
+        let (cx, cy) = (
+            (rect.x0 + rect.x1 + 1) as f32 * 0.5,
+            (rect.y0 + rect.y1 + 1) as f32 * 0.5,
+        );
+        Frustum {
+            rect,
+            planes: planes.map(|(n, offset)| (Vec3A::from(n), offset)),
+            centre: SlabRay::new(v.origin(cx, cy), v.direction(cx, cy)),
+        }
+    }
+}
+
 impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
     /// A traversal of the frustum over `tile`'s pixels, leaf triangles set up
     /// by `setup` over their `boxes`.
@@ -103,9 +153,9 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
             return;
         }
         let root = self.node_box(bvh.total_aabb.min, bvh.total_aabb.max);
-        let f = self.tile.rect();
+        let f = Frustum::new(self.tile.rect(), self.view);
         self.counters.frusta_created += 1;
-        self.traverse(f, NodeRef::Inner(0), root);
+        self.traverse(&f, NodeRef::Inner(0), root);
     }
 
     fn node_box(&self, min: Vec3A, max: Vec3A) -> NodeBox {
@@ -121,10 +171,11 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
     }
 
     /// Fig. 7.
-    fn traverse(&mut self, f: PixelRect, node: NodeRef, b: NodeBox) {
+    fn traverse(&mut self, frustum: &Frustum, node: NodeRef, b: NodeBox) {
         self.nodes_visited += 1;
+        let f = frustum.rect;
         // 1. is_outside / is_occluded (Fig. 6a).
-        if self.oracles.outside && self.is_outside(f, &b) {
+        if self.oracles.outside && self.is_outside(frustum, &b) {
             self.counters.nodes_culled_outside += 1;
             return;
         }
@@ -134,7 +185,7 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
         }
         // 2. split_frustum (Fig. 6b, c).
         if let Some(min) = self.oracles.split
-            && self.should_split(f, &b, min)
+            && self.should_split(frustum, &b, min)
         {
             self.counters.frusta_split += 1;
             let (hx, hy) = ((f.x0 + f.x1) / 2, (f.y0 + f.y1) / 2);
@@ -166,7 +217,7 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
             ] {
                 if q.x0 <= q.x1 && q.y0 <= q.y1 {
                     self.counters.frusta_created += 1;
-                    self.traverse(q, node, b);
+                    self.traverse(&Frustum::new(q, self.view), node, b);
                 }
             }
             return;
@@ -196,71 +247,41 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
                 }
                 children[..len].sort_by(|a, b| a.0.total_cmp(&b.0));
                 for &(_, r, cb) in &children[..len] {
-                    self.traverse(f, r, cb);
+                    self.traverse(frustum, r, cb);
                 }
             }
         }
     }
 
-    /// Is the box wholly outside one of the frustum's side planes (at the pixel
-    /// borders of `f`: through the eye under perspective, parallel to the view
-    /// axis under orthographic projection), or nearer than `near`?
-    fn is_outside(&self, f: PixelRect, b: &NodeBox) -> bool {
+    /// Is the box wholly outside one of the frustum's side planes, or nearer
+    /// than `near`?
+    fn is_outside(&self, f: &Frustum, b: &NodeBox) -> bool {
         let v = self.view;
-        let (fw, right, up) = (v.forward, v.right, v.up);
-        // Image x of a camera-space point is (x/w / half_x + 1)·W/2 (orthographic:
-        // x instead of x/w); border lines at the rect's pixel edges (half a pixel
-        // beyond its outermost samples).
-        let kx = |x: u32| (2.0 * x as f32 / v.width as f32 - 1.0) * v.half_x;
-        let ky = |y: u32| (1.0 - 2.0 * y as f32 / v.height as f32) * v.half_y;
-        let (left, right_border) = (kx(f.x0), kx(f.x1 + 1));
-        let (top, bottom) = (ky(f.y0), ky(f.y1 + 1));
-        // Each plane as n·(p − eye) ≥ offset.
-        let planes = if v.is_orthographic() {
-            [
-                (right, left),
-                (-right, -right_border),
-                (-up, -top),
-                (up, bottom),
-            ]
-        } else {
-            [
-                (right - fw * left, 0.0),
-                (fw * right_border - right, 0.0),
-                (fw * top - up, 0.0),
-                (up - fw * bottom, 0.0),
-            ]
-        };
         let eye = Vec3A::from(v.eye);
-        let outside_plane = |(n, offset): (Vec3, f32)| {
-            let n = Vec3A::from(n);
+        for &(n, offset) in &f.planes {
             // The corner furthest along n.
             let corner = Vec3A::select(n.cmpge(Vec3A::ZERO), b.hi, b.lo);
-            (corner - eye).dot(n) < offset
-        };
-        if planes.into_iter().any(outside_plane) {
-            return true;
+            if (corner - eye).dot(n) < offset {
+                return true;
+            }
         }
         // Wholly nearer than near: the farthest corner along the view axis.
-        let far = Vec3A::select(Vec3A::from(fw).cmpge(Vec3A::ZERO), b.hi, b.lo);
-        (far - eye).dot(Vec3A::from(fw)) < v.near
+        let fw = Vec3A::from(v.forward);
+        let far = Vec3A::select(fw.cmpge(Vec3A::ZERO), b.hi, b.lo);
+        (far - eye).dot(fw) < v.near
     }
 
     /// Split when the frustum is still larger than `min` and the node is not a
     /// good fit: its box misses the frustum's centre ray, or it is small against
     /// the frustum (paper §5, "3DR frustum split").
-    fn should_split(&self, f: PixelRect, b: &NodeBox, min: u32) -> bool {
+    fn should_split(&self, frustum: &Frustum, b: &NodeBox, min: u32) -> bool {
+        let f = frustum.rect;
         let (w, h) = (f.x1 - f.x0 + 1, f.y1 - f.y0 + 1);
         if w.max(h) <= min {
             return false;
         }
         let v = self.view;
-        let (cx, cy) = (
-            (f.x0 + f.x1 + 1) as f32 * 0.5,
-            (f.y0 + f.y1 + 1) as f32 * 0.5,
-        );
-        let (origin, direction) = (v.origin(cx, cy), v.direction(cx, cy));
-        if !SlabRay::new(origin, direction).hits(b.lo, b.hi, f32::INFINITY) {
+        if !frustum.centre.hits(b.lo, b.hi, f32::INFINITY) {
             return true;
         }
         // Projected size of the box in pixels (perspective: at its nearest distance).

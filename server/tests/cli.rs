@@ -380,6 +380,18 @@ fn compare_writes_results_with_the_documented_keys() {
         if row["algorithm"] != "peer-obvhs" {
             assert_eq!(row["agrees"], true, "{row}");
         }
+        // Visibility alone: the whole render for a peer (it shades nothing),
+        // no more than the whole render for ours.
+        let (visibility, median) = (row["visibility_ms"].as_f64(), row["median_ms"].as_f64());
+        let (visibility, median) = (
+            visibility.expect("visibility_ms"),
+            median.expect("median_ms"),
+        );
+        if row["algorithm"] == "peer-obvhs" {
+            assert_eq!(visibility, median, "{row}");
+        } else {
+            assert!(visibility > 0.0 && visibility <= median, "{row}");
+        }
     }
     let csv = std::fs::read_to_string(dir.join("results.csv")).expect("results.csv");
     assert_eq!(csv.lines().count(), 11);
@@ -577,6 +589,7 @@ fn untimed(row: &serde_json::Value) -> String {
         "median_ms",
         "min_ms",
         "max_ms",
+        "visibility_ms",
         "rays_per_second",
         "ratio_to_2dr_brute",
         "ratio_to_aa_none",

@@ -388,13 +388,23 @@ pub(crate) fn run(
         Pipeline::Frusta(oracles) => {
             render_frusta(scene, context, oracles, fb, stats, Triangle3D::setup)
         }
-        Pipeline::Rays if view.sphere.is_some() => {
-            raycast::render_raycast(scene, context, fb, stats, CurvedTriangle::setup)
+        Pipeline::Rays if view.sphere.is_some() => raycast::render_raycast(
+            scene,
+            context,
+            fb,
+            stats,
+            setup3d::one_by_one(CurvedTriangle::setup),
+        ),
+        Pipeline::Rays if f64 => raycast::render_raycast(
+            scene,
+            context,
+            fb,
+            stats,
+            setup3d::one_by_one(Triangle3D64::setup),
+        ),
+        Pipeline::Rays => {
+            raycast::render_raycast(scene, context, fb, stats, Triangle3D::setup_eight)
         }
-        Pipeline::Rays if f64 => {
-            raycast::render_raycast(scene, context, fb, stats, Triangle3D64::setup)
-        }
-        Pipeline::Rays => raycast::render_raycast(scene, context, fb, stats, Triangle3D::setup),
         Pipeline::Gpu => unreachable!("gpu-raster renders through crate::gpu"),
     };
     stats.counters = pass.counters;
@@ -583,6 +593,34 @@ impl fmt::Display for AlgorithmId {
     }
 }
 
+/// Every f32 of magnitude 2²³ or more is an integer.
+const INTEGRAL_ABOVE: f32 = 8_388_608.0;
+
+/// `v.floor()` up to the sign of a zero result, inline: baseline x86-64 has
+/// no rounding instruction and `f32::floor` is a libm call (once per triangle
+/// bound in every setup). Truncation is exact below [`INTEGRAL_ABOVE`]; at and
+/// beyond it (and for ±∞ and NaN) `v` is its own floor.
+#[inline(always)]
+fn floor(v: f32) -> f32 {
+    if v.abs() < INTEGRAL_ABOVE {
+        let t = v as i32 as f32;
+        if t > v { t - 1.0 } else { t }
+    } else {
+        v
+    }
+}
+
+/// `v.ceil()` up to the sign of a zero result (see [`floor`]).
+#[inline(always)]
+fn ceil(v: f32) -> f32 {
+    if v.abs() < INTEGRAL_ABOVE {
+        let t = v as i32 as f32;
+        if t < v { t + 1.0 } else { t }
+    } else {
+        v
+    }
+}
+
 /// An algorithm id that is not one of [`AlgorithmId::ALL`].
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[error("unknown algorithm '{given}'; valid ids are: {}", AlgorithmId::ALL.map(|a| a.as_str()).join(", "))]
@@ -645,8 +683,8 @@ impl PixelRect {
     ) -> Option<PixelRect> {
         // Pixel p's samples lie in [p + lo, p + hi]: first p with p + hi ≥ min,
         // last with p + lo ≤ max.
-        let first = |v: f32, hi: f32| (v - hi).ceil().max(0.0);
-        let last = |v: f32, lo: f32, n: u32| (v - lo).floor().min(n as f32 - 1.0);
+        let first = |v: f32, hi: f32| ceil(v - hi).max(0.0);
+        let last = |v: f32, lo: f32, n: u32| floor(v - lo).min(n as f32 - 1.0);
         let (x0, y0) = (first(min_x, span.hi[0]), first(min_y, span.hi[1]));
         let (x1, y1) = (
             last(max_x, span.lo[0], width),
@@ -662,5 +700,50 @@ impl PixelRect {
             x1: x1 as u32,
             y1: y1 as u32,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{ceil, floor};
+
+    /// Equal to the library's, zero signs aside, on random values of every
+    /// magnitude, on and around integers, halves, the integral threshold and
+    /// the specials.
+    #[test]
+    fn inline_floor_and_ceil_are_the_library_ones() {
+        let mut rng = fastrand::Rng::with_seed(3);
+        let mut values = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            8_388_607.5,
+            -8_388_607.5,
+            8_388_608.0,
+            -8_388_609.0,
+            1e30,
+            -1e30,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ];
+        for _ in 0..100_000 {
+            let v = (rng.f32() - 0.5) * 10f32.powi(rng.i32(-8..12));
+            values.extend([
+                v,
+                v.round(),
+                v.round() + 0.5,
+                f32::from_bits(v.to_bits() + 1),
+            ]);
+        }
+        for v in values {
+            assert_eq!(floor(v), v.floor(), "floor({v:e})");
+            assert_eq!(ceil(v), v.ceil(), "ceil({v:e})");
+        }
+        assert!(floor(f32::NAN).is_nan() && ceil(f32::NAN).is_nan());
     }
 }

@@ -8,9 +8,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use glam::Vec3;
-
-use super::setup3d::{self, SlotSetups};
+use super::setup3d::{self, SetupEight, SlotSetups};
 use super::{Pass, PixelRect, TileContext};
 use crate::aa::SamplePattern;
 use crate::bvh::{PACKET, PacketRays};
@@ -47,7 +45,7 @@ pub(crate) fn render_raycast<'a, T: Coverage + Send + Sync>(
     context: &TileContext<'a>,
     fb: &mut Framebuffer,
     stats: &mut Stats,
-    setup: impl Fn(&'a [Vec3; 3], &'a View) -> Option<T> + Sync,
+    setup: impl SetupEight<'a, T>,
 ) -> Pass {
     let view = context.view;
     // 1. Setup: the 3D edge functions of every triangle with samples on

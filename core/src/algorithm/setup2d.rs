@@ -4,6 +4,7 @@
 //! polygon — in f32 ([`Triangle2D`]) or on snapped vertices in fixed point
 //! ([`Triangle2DFixed`]).
 
+use glam::DVec3;
 use rayon::prelude::*;
 
 use super::PixelRect;
@@ -51,6 +52,12 @@ pub(crate) fn setup_2d_fixed(
 /// triangle holds its first piece (an exactly sized, parallel collect written
 /// in place); the further pieces of the few triangles clipping cuts into
 /// several follow, set up again in a second, small pass.
+///
+/// Vertices are transformed and projected once each, as a vertex shader
+/// would ([`screen_vertices`]): a triangle whose three vertices are inside
+/// every plane is its own clipped polygon and takes them as they are — the
+/// very values [`pieces_of`] would compute for it — while the others are
+/// clipped.
 fn setup_pieces<T: Send>(
     scene: &PreparedScene,
     view: &View,
@@ -59,11 +66,16 @@ fn setup_pieces<T: Send>(
     make: impl Fn(&[ScreenVertex; 3]) -> Option<(T, [f32; 4])> + Sync,
 ) -> Vec<Option<Placed<T>>> {
     let planes = pipeline_planes(view, guard);
+    let kept = screen_vertices(scene, view, &planes);
+    let corners = &scene.scene.mesh.triangles;
     let pieces = |id: u32| pieces_of(scene, view, span, &planes, &make, id);
     let (mut placed, more): (Vec<Option<Placed<T>>>, Vec<bool>) = scene
         .drawable
         .par_iter()
         .map(|&id| {
+            if let [Some(a), Some(b), Some(c)] = corners[id as usize].map(|v| kept[v as usize]) {
+                return (piece(view, span, &make, &[a, b, c], id), false);
+            }
             let mut pieces = pieces(id).into_iter().flatten();
             (pieces.next(), pieces.next().is_some())
         })
@@ -79,6 +91,57 @@ fn setup_pieces<T: Send>(
     placed
 }
 
+/// Per mesh vertex: its projection when it is inside every clip plane (`None`
+/// when some plane would clip it).
+fn screen_vertices(
+    scene: &PreparedScene,
+    view: &View,
+    planes: &[ClipPlane],
+) -> Vec<Option<ScreenVertex>> {
+    let positions = &scene.scene.mesh.positions;
+    (positions.par_iter())
+        .map(|&p| {
+            let c = view.to_camera_f64(p);
+            planes
+                .iter()
+                .all(|plane| plane.keeps(c))
+                .then(|| screen_vertex(view, c))
+        })
+        .collect()
+}
+
+/// A camera-space point projected to the image, with its depth quantity
+/// (`1/w` under perspective, `w` under orthographic projection).
+#[inline]
+fn screen_vertex(view: &View, c: DVec3) -> ScreenVertex {
+    let (x, y) = view.project_f64(c);
+    let q = if view.is_orthographic() {
+        c.z
+    } else {
+        1.0 / c.z
+    };
+    ScreenVertex {
+        x: x as f32,
+        y: y as f32,
+        q: q as f32,
+    }
+}
+
+/// One projected piece of triangle `id` set up by `make`, with its pixels;
+/// `None` when it has no samples on screen.
+#[inline]
+fn piece<T>(
+    view: &View,
+    span: SampleSpan,
+    make: &impl Fn(&[ScreenVertex; 3]) -> Option<(T, [f32; 4])>,
+    vertices: &[ScreenVertex; 3],
+    id: u32,
+) -> Option<Placed<T>> {
+    let (tri, [x0, y0, x1, y1]) = make(vertices)?;
+    let rect = PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height, span)?;
+    Some(Placed { tri, rect, id })
+}
+
 /// The set-up pieces of triangle `id` after clipping and fan triangulation,
 /// in fan order (`None` where a piece has no samples on screen).
 fn pieces_of<T>(
@@ -89,7 +152,6 @@ fn pieces_of<T>(
     make: &impl Fn(&[ScreenVertex; 3]) -> Option<(T, [f32; 4])>,
     id: u32,
 ) -> [Option<Placed<T>>; MAX_CLIPPED - 2] {
-    let affine = view.is_orthographic();
     let mut pieces: [Option<Placed<T>>; MAX_CLIPPED - 2] = std::array::from_fn(|_| None);
     // 1. Transform and clip.
     let p = &scene.triangles[id as usize];
@@ -103,22 +165,12 @@ fn pieces_of<T>(
         y: 0.0,
         q: 0.0,
     }; MAX_CLIPPED];
-    for (s, c) in screen.iter_mut().zip(poly.as_slice()) {
-        let (x, y) = view.project_f64(*c);
-        *s = ScreenVertex {
-            x: x as f32,
-            y: y as f32,
-            q: (if affine { c.z } else { 1.0 / c.z }) as f32,
-        };
+    for (s, &c) in screen.iter_mut().zip(poly.as_slice()) {
+        *s = screen_vertex(view, c);
     }
     // 3. Fan-triangulate and set up each piece.
     for k in 1..poly.len - 1 {
-        let Some((tri, [x0, y0, x1, y1])) = make(&[screen[0], screen[k], screen[k + 1]]) else {
-            continue;
-        };
-        if let Some(rect) = PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height, span) {
-            pieces[k - 1] = Some(Placed { tri, rect, id });
-        }
+        pieces[k - 1] = piece(view, span, make, &[screen[0], screen[k], screen[k + 1]], id);
     }
     pieces
 }

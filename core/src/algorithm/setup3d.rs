@@ -19,7 +19,7 @@ pub(crate) fn setup_3d<'a>(
     view: &'a View,
     span: SampleSpan,
 ) -> Vec<Option<Placed<Triangle3D<'a>>>> {
-    setup_visible(scene, view, span, Triangle3D::setup)
+    setup_visible(scene, view, span, Triangle3D::setup_eight)
 }
 
 /// [`setup_3d`] in f64.
@@ -28,7 +28,7 @@ pub(crate) fn setup_3d_f64(
     view: &View,
     span: SampleSpan,
 ) -> Vec<Option<Placed<Triangle3D64>>> {
-    setup_visible(scene, view, span, Triangle3D64::setup)
+    setup_visible(scene, view, span, one_by_one(Triangle3D64::setup))
 }
 
 /// Every drawable triangle with samples on a non-planar viewport, set up with 3D
@@ -38,7 +38,7 @@ pub(crate) fn setup_curved(
     view: &View,
     span: SampleSpan,
 ) -> Vec<Option<Placed<CurvedTriangle>>> {
-    setup_visible(scene, view, span, CurvedTriangle::setup)
+    setup_visible(scene, view, span, one_by_one(CurvedTriangle::setup))
 }
 
 /// Every drawable triangle with samples on screen, set up for homogeneous 2D
@@ -48,65 +48,134 @@ pub(crate) fn setup_homogeneous<'a>(
     view: &'a View,
     span: SampleSpan,
 ) -> Vec<Option<Placed<Triangle3D<'a>>>> {
-    setup_visible(scene, view, span, edge::setup_homogeneous)
+    setup_visible(scene, view, span, one_by_one(edge::setup_homogeneous))
 }
+
+/// A setup of eight triangles at a time (bit `l` of the mask: lane `l` is
+/// to be set up), such as [`Triangle3D::setup_eight`].
+pub(crate) trait SetupEight<'a, T>:
+    Fn([&'a [Vec3; 3]; 8], u8, &'a View) -> [Option<T>; 8] + Sync
+{
+}
+
+impl<'a, T, F: Fn([&'a [Vec3; 3]; 8], u8, &'a View) -> [Option<T>; 8] + Sync> SetupEight<'a, T>
+    for F
+{
+}
+
+/// A one-triangle setup applied lane by lane.
+pub(crate) fn one_by_one<'a, T>(
+    setup: impl Fn(&'a [Vec3; 3], &'a View) -> Option<T> + Sync,
+) -> impl SetupEight<'a, T> {
+    move |p: [&'a [Vec3; 3]; 8], present: u8, view: &'a View| {
+        let mut out = [const { None }; 8];
+        for l in 0..8 {
+            if present >> l & 1 == 1 {
+                out[l] = setup(p[l], view);
+            }
+        }
+        out
+    }
+}
+
+/// A BVH slot's triangle's screen box and id (`None`: nothing to test).
+pub(crate) type SlotBox = Option<(PixelRect, u32)>;
 
 /// Per BVH slot, its triangle's conservative screen box and id, and apart
 /// from them its edge functions — so a ray caster reads the small box first
 /// and the edge functions only where the box holds its rays. `None` (in
 /// both) for a triangle off screen or edge-on.
 pub(crate) struct SlotSetups<T> {
-    pub boxes: Vec<Option<(PixelRect, u32)>>,
+    pub boxes: Vec<SlotBox>,
     pub triangles: Vec<Option<T>>,
 }
 
 /// Every BVH slot's triangle set up by `setup` with its conservative screen
 /// box, in slot order (from the scene's slot-ordered copies of positions and
-/// vertex indices: memory read in order).
+/// vertex indices: memory read in order), eight slots at a time.
 pub(crate) fn setup_slots<'a, T: Send>(
     scene: &'a PreparedScene,
     view: &'a View,
     span: SampleSpan,
-    setup: impl Fn(&'a [Vec3; 3], &'a View) -> Option<T> + Sync,
+    setup: impl SetupEight<'a, T>,
 ) -> SlotSetups<T> {
     let boxes = ScreenBoxes::new(scene, view);
-    let (boxes, triangles) = (scene.slot_corners.par_iter())
-        .zip(&scene.slot_vertices)
-        .zip(&scene.slot_triangles)
-        .map(|((p, &vertices), &id)| {
-            let rect = boxes.rect(p, vertices, view, span);
-            match rect.and_then(|rect| Some((rect, setup(p, view)?))) {
-                Some((rect, tri)) => (Some((rect, id)), Some(tri)),
-                None => (None, None),
+    let (boxes, triangles): (Vec<[SlotBox; 8]>, Vec<[Option<T>; 8]>) = (scene
+        .slot_corners
+        .par_chunks(8))
+    .zip(scene.slot_vertices.par_chunks(8))
+    .zip(scene.slot_triangles.par_chunks(8))
+    .map(|((p, vertices), ids)| {
+        let (rects, present) = rects_of(p.len(), |l| boxes.rect(&p[l], vertices[l], view, span));
+        let triangles = setup(lanes_of(p), present, view);
+        let mut boxes = [None; 8];
+        for l in 0..p.len() {
+            if triangles[l].is_some() {
+                boxes[l] = rects[l].map(|rect| (rect, ids[l]));
             }
-        })
-        .unzip();
+        }
+        (boxes, triangles)
+    })
+    .unzip();
+    let (mut boxes, mut triangles) = (boxes.into_flattened(), triangles.into_flattened());
+    boxes.truncate(scene.slot_triangles.len());
+    triangles.truncate(scene.slot_triangles.len());
     SlotSetups { boxes, triangles }
 }
 
+/// Up to eight triangles as lanes (the last one repeated past the end).
+#[inline]
+fn lanes_of(p: &[[Vec3; 3]]) -> [&[Vec3; 3]; 8] {
+    std::array::from_fn(|l| &p[l.min(p.len() - 1)])
+}
+
+/// The screen boxes `rect(l)` of the first `n` lanes, and the mask of the
+/// lanes that have one (the lanes to set up).
+#[inline]
+fn rects_of(n: usize, rect: impl Fn(usize) -> Option<PixelRect>) -> ([Option<PixelRect>; 8], u8) {
+    let (mut rects, mut present) = ([None; 8], 0u8);
+    for (l, slot) in rects.iter_mut().enumerate().take(n) {
+        *slot = rect(l);
+        present |= u8::from(slot.is_some()) << l;
+    }
+    (rects, present)
+}
+
 /// Every drawable triangle set up by `setup` with its conservative screen
-/// box: one slot per triangle, in order (an exactly sized, parallel collect:
-/// no chunks to concatenate); `None` for the ones off screen or edge-on.
+/// box: one slot per triangle, in order (an exactly sized, parallel collect
+/// of eight at a time: no chunks to concatenate); `None` for the ones off
+/// screen or edge-on.
 fn setup_visible<'a, T: Send>(
     scene: &'a PreparedScene,
     view: &'a View,
     span: SampleSpan,
-    setup: impl Fn(&'a [Vec3; 3], &'a View) -> Option<T> + Sync,
+    setup: impl SetupEight<'a, T>,
 ) -> Vec<Option<Placed<T>>> {
     let boxes = ScreenBoxes::new(scene, view);
-    scene
-        .drawable
-        .par_iter()
-        .map(|&id| {
-            let p = &scene.triangles[id as usize];
-            let rect = boxes.rect(p, scene.scene.mesh.triangles[id as usize], view, span)?;
-            Some(Placed {
-                tri: setup(p, view)?,
-                rect,
-                id,
-            })
+    let corners = &scene.scene.mesh.triangles;
+    let placed: Vec<[Option<Placed<T>>; 8]> = (scene.drawable.par_chunks(8))
+        .map(|ids| {
+            let p: [&[Vec3; 3]; 8] =
+                std::array::from_fn(|l| &scene.triangles[ids[l.min(ids.len() - 1)] as usize]);
+            let (rects, present) = rects_of(ids.len(), |l| {
+                boxes.rect(p[l], corners[ids[l] as usize], view, span)
+            });
+            let mut placed = [const { None }; 8];
+            for (l, tri) in setup(p, present, view).into_iter().enumerate() {
+                if let (Some(tri), Some(rect)) = (tri, rects[l]) {
+                    placed[l] = Some(Placed {
+                        tri,
+                        rect,
+                        id: ids[l],
+                    });
+                }
+            }
+            placed
         })
-        .collect()
+        .collect();
+    let mut placed = placed.into_flattened();
+    placed.truncate(scene.drawable.len());
+    placed
 }
 
 /// A conservative screen box for the part of the triangle at `w ≥ near`: the

@@ -68,7 +68,7 @@ pub struct Triangle3D<'a> {
     /// sign decides.
     pub tolerance: [f32; 3],
     /// The f32 geometry the exact decisions are made on.
-    exact: ExactEdges<'a>,
+    pub(super) exact: ExactEdges<'a>,
 }
 
 /// Which exact edge functions a [`Triangle3D`] stands for.
@@ -130,23 +130,42 @@ pub(crate) fn abs_cross(a: Vec3, b: Vec3) -> Vec3 {
 }
 
 /// Vertices beyond this many units make setup products overflow f32.
-const SCALE_ABOVE: f32 = (1u64 << 32) as f32;
+pub(super) const SCALE_ABOVE: f32 = (1u64 << 32) as f32;
 
 /// `c` scaled by a power of two `2⁻ᵏ` so that its largest coordinate is about 1
 /// when it exceeds [`SCALE_ABOVE`] (unscaled otherwise), and `2ᵏ`. Exact: every
 /// product and sum of the setup scales with it, rounding alike, so the shared
 /// edges of neighbours stay exactly negated whatever their scales.
+#[inline(always)]
 pub(crate) fn scaled(c: [Vec3; 3]) -> ([Vec3; 3], f32) {
-    let max = c
-        .iter()
-        .map(|v| v.abs().max_element())
-        .fold(0.0f32, f32::max);
-    if !(max > SCALE_ABOVE && max.is_finite()) {
-        return (c, 1.0);
+    // Unrolled, not an iterator fold: this runs once per triangle setup and a
+    // call here passed the vertices through memory.
+    let largest = |v: Vec3| v.abs().max_element();
+    let max = largest(c[0]).max(largest(c[1])).max(largest(c[2]));
+    if max > SCALE_ABOVE && max.is_finite() {
+        scaled_down(c, max)
+    } else {
+        (c, 1.0)
     }
+}
+
+/// [`scaled`] for vertices beyond [`SCALE_ABOVE`] (rare: far from the eye).
+#[cold]
+fn scaled_down(c: [Vec3; 3], max: f32) -> ([Vec3; 3], f32) {
     let k = max.log2().ceil() as i32;
     let down = 2f32.powi(-k);
     (c.map(|v| v * down), 2f32.powi(k))
+}
+
+/// Whether every value is finite, without a branch per value: zero times a
+/// finite value is ±0, times ±∞ or NaN it is NaN, and NaN stays in a sum.
+#[inline(always)]
+fn all_finite(values: &[[f32; 3]]) -> bool {
+    let mut nan = 0.0f32;
+    for v in values.iter().flatten() {
+        nan += v * 0.0;
+    }
+    nan == 0.0
 }
 
 /// Linear functions of the image point, `k[0] + x·k[1] + y·k[2]`.
@@ -278,6 +297,7 @@ impl<'a> Triangle3D<'a> {
     /// the bound on each edge's coefficient error over the image, and the exact
     /// edges it stands for; adds the evaluation's rounding to the tolerance.
     /// `None` on non-finite values.
+    #[inline(always)]
     pub(crate) fn from_linear(
         edges: [Linear; 3],
         nd: Linear,
@@ -308,14 +328,8 @@ impl<'a> Triangle3D<'a> {
             }),
             exact,
         };
-        let finite = edges
-            .iter()
-            .flatten()
-            .chain(&nd)
-            .chain(&volume)
-            .chain(&t.w_range)
-            .chain(&t.tolerance)
-            .all(|v| v.is_finite());
+        let finite = all_finite(&[edges[0], edges[1], edges[2], nd, volume, t.tolerance])
+            && t.w_range.iter().all(|w| w.is_finite());
         finite.then_some(t)
     }
 

@@ -17,6 +17,7 @@ mod edge2d;
 pub mod edge2d_fixed;
 mod edge3d;
 mod edge3d_f64;
+mod edge3d_lanes;
 mod exact;
 mod homogeneous;
 

@@ -38,6 +38,14 @@ const AMBIENT: f32 = 0.12;
 /// surface they leave, besides skipping its own triangle.
 const SECONDARY_OFFSET: f32 = 1e-5;
 
+/// Where a light shines from: the unit direction toward it (directional
+/// lights), or its position.
+#[derive(Clone, Copy, Debug)]
+enum LightFrom {
+    Direction(Vec3),
+    Position(Vec3),
+}
+
 /// Shades samples of one scene.
 #[derive(Clone, Debug)]
 pub struct Shader<'a> {
@@ -47,6 +55,9 @@ pub struct Shader<'a> {
     plan: EffectPlan,
     /// Per light: its slot among the plan's shadow lights.
     shadow_slot: Vec<Option<usize>>,
+    /// Per light, what every sample uses alike: where it shines from, and its
+    /// colour (at most one per channel).
+    light_terms: Vec<(LightFrom, Vec3)>,
     rays: Rays<'a>,
     t_min: f32,
 }
@@ -57,12 +68,26 @@ impl<'a> Shader<'a> {
         let shadow_slot = (0..scene.scene.lights.len())
             .map(|l| plan.shadow_lights.iter().position(|&s| s == l))
             .collect();
+        let light_terms = (scene.scene.lights.iter())
+            .map(|light| {
+                let toward = match &light.kind {
+                    LightKind::Directional { direction } => {
+                        LightFrom::Direction(-direction.normalize_or_zero())
+                    }
+                    LightKind::Point { position } | LightKind::Spot { position, .. } => {
+                        LightFrom::Position(*position)
+                    }
+                };
+                (toward, Vec3::from(light.color).min(Vec3::ONE))
+            })
+            .collect();
         Shader {
             scene,
             view,
             filter,
             plan,
             shadow_slot,
+            light_terms,
             rays: Rays::new(scene),
             t_min: scene.bounds.radius().max(f32::MIN_POSITIVE) * SECONDARY_OFFSET,
         }
@@ -127,7 +152,6 @@ impl<'a> Shader<'a> {
         effects: &mut EffectCounters,
     ) -> (Vec3, f32) {
         let point = origin + dir * t;
-        let view_dir = dir.normalize_or_zero();
         let scene = &self.scene.scene;
         let mesh = &scene.mesh;
         let material = &scene.materials[mesh.material_ids[id as usize] as usize];
@@ -143,15 +167,13 @@ impl<'a> Shader<'a> {
         // surfaces it passes (primary surfaces only, Fig. 8).
         let mut lit = Vec3::ZERO;
         if scene.lights.is_empty() {
-            lit = Vec3::splat(normal.dot(-view_dir).max(0.0));
+            lit = Vec3::splat(normal.dot(-dir.normalize_or_zero()).max(0.0));
         }
-        for (l, light) in scene.lights.iter().enumerate() {
-            let (to_light, distance) = match &light.kind {
-                LightKind::Directional { direction } => {
-                    (-direction.normalize_or_zero(), f32::INFINITY)
-                }
-                LightKind::Point { position } | LightKind::Spot { position, .. } => {
-                    let to = *position - point;
+        for (l, &(from, color)) in self.light_terms.iter().enumerate() {
+            let (to_light, distance) = match from {
+                LightFrom::Direction(toward) => (toward, f32::INFINITY),
+                LightFrom::Position(position) => {
+                    let to = position - point;
                     (to.normalize_or_zero(), to.length())
                 }
             };
@@ -173,7 +195,7 @@ impl<'a> Shader<'a> {
                 }
                 lambert *= passed;
             }
-            lit += Vec3::from(light.color).min(Vec3::ONE) * lambert;
+            lit += color * lambert;
         }
         let mut base = Vec3::new(
             material.base_color[0],
@@ -208,6 +230,7 @@ impl<'a> Shader<'a> {
         }
         let start = Instant::now();
         effects.reflection_rays += 1;
+        let view_dir = dir.normalize_or_zero();
         let mirrored = view_dir - 2.0 * view_dir.dot(normal) * normal;
         let hit = self.rays.closest(point, mirrored, self.t_min, id);
         effects.reflection_s += start.elapsed().as_secs_f64();

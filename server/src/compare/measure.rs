@@ -167,6 +167,8 @@ pub fn measure_cell(
                         json!({ "bvh_build_ms": run.build_ms }),
                     );
                 row.coverage_samples = u64::from(width) * u64::from(height);
+                // Peers find the visible triangle and shade nothing.
+                row.visibility_ms = Some(row.median_ms);
                 Measured {
                     row,
                     keys: run.triangle_id.iter().map(|&t| u64::from(t)).collect(),
@@ -225,22 +227,32 @@ fn time_interleaved(
     scene: &LoadedScene,
     requests: &[RenderRequest],
     repeat: u32,
-) -> Result<Vec<(continuum::RenderOutput, Vec<f64>)>, CliError> {
+) -> Result<Vec<(continuum::RenderOutput, Times)>, CliError> {
     let render_one = |request: &RenderRequest| {
         pool.install(|| render(&scene.prepared, request))
             .map_err(|e| CliError::Usage(format!("{e}")))
     };
     let mut timed = requests
         .iter()
-        .map(|r| Ok((render_one(r)?, Vec::new())))
+        .map(|r| Ok((render_one(r)?, Times::default())))
         .collect::<Result<Vec<_>, CliError>>()?;
     for _ in 0..repeat {
         for (request, (out, times)) in requests.iter().zip(&mut timed) {
             *out = render_one(request)?;
-            times.push(out.stats.time_ms.total);
+            let t = out.stats.time_ms;
+            times.total.push(t.total);
+            times.visibility.push(t.total - t.shading);
         }
     }
     Ok(timed)
+}
+
+/// The times of an algorithm's rounds (ms): whole renders, and the same
+/// renders without their shading stage.
+#[derive(Debug, Default)]
+struct Times {
+    total: Vec<f64>,
+    visibility: Vec<f64>,
 }
 
 /// The row of an algorithm from its last render and the times of its rounds.
@@ -250,14 +262,14 @@ fn algorithm_row(
     sweep: &Sweep,
     threads: usize,
     out: continuum::RenderOutput,
-    times: Vec<f64>,
+    times: Times,
 ) -> Measured {
     let mut row = Row::timed(
         &scene.prepared.scene.name,
         algorithm.as_str(),
         sweep.size,
         threads,
-        times,
+        times.total,
     )
     .with(
         &out.viewport,
@@ -265,6 +277,7 @@ fn algorithm_row(
         serde_json::to_value(&out.stats).unwrap_or(Value::Null),
     );
     row.hashes = serde_json::to_value(&out.hashes).unwrap_or(Value::Null);
+    row.visibility_ms = Some(super::median(times.visibility).0);
     row.precision = cell.precision;
     row.shading_samples = out.stats.shading_samples;
     row.coverage_samples = out.stats.coverage_samples;

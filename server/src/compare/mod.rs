@@ -117,6 +117,11 @@ pub struct Row {
     pub ratio_to_2dr_brute: Option<f64>,
     pub predicted_ratio: Option<f64>,
     pub rays_per_second: f64,
+    /// The median render without its shading stage: finding what each sample
+    /// sees (setup, traversal, binning, coverage) — what the peers, which
+    /// shade nothing, are timed doing.
+    #[serde(default)]
+    pub visibility_ms: Option<f64>,
     pub stats: Value,
     pub hashes: Value,
     /// Does the triangle-id buffer equal its family's reference (for peers and
@@ -170,6 +175,7 @@ impl Row {
             ratio_to_2dr_brute: None,
             predicted_ratio: None,
             rays_per_second: f64::from(width) * f64::from(height) / (median_ms / 1e3),
+            visibility_ms: None,
             stats: Value::Null,
             hashes: Value::Null,
             agrees: false,
@@ -487,7 +493,7 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
     let mut f =
         std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
     let mut text = String::from(
-        "scene,algorithm,camera,viewport,aa,precision,width,height,threads,median_ms,min_ms,max_ms,ratio_to_2dr_brute,predicted_ratio,rays_per_second,triangle_setups,edge_evaluations,bvh_nodes_visited,agrees,pixels_differing_from_3dr_brute,triangle_id_hash,ratio_to_aa_none,ratio_to_f32,shading_samples,coverage_samples,psnr,psnr_edges,flip_mean\n",
+        "scene,algorithm,camera,viewport,aa,precision,width,height,threads,median_ms,min_ms,max_ms,ratio_to_2dr_brute,predicted_ratio,rays_per_second,triangle_setups,edge_evaluations,bvh_nodes_visited,agrees,pixels_differing_from_3dr_brute,triangle_id_hash,ratio_to_aa_none,ratio_to_f32,shading_samples,coverage_samples,psnr,psnr_edges,flip_mean,visibility_ms\n",
     );
     let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.4}"));
     for r in rows {
@@ -498,7 +504,7 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
                 .map_or(String::new(), |v| v.to_string())
         };
         text.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{:.0},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{:.0},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             r.scene,
             r.algorithm,
             r.camera,
@@ -531,6 +537,7 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
             opt(r.psnr),
             opt(r.psnr_edges),
             r.flip_mean.map_or(String::new(), |v| format!("{v:.6}")),
+            opt(r.visibility_ms),
         ));
     }
     f.write_all(text.as_bytes())

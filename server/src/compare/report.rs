@@ -231,7 +231,7 @@ fn peers(h: &mut String, rows: &[Row]) {
     if !rows.iter().any(peer) {
         return;
     }
-    h.push_str("<h2 id=\"peers\">Peers</h2>\n<p>peer-obvhs (obvhs's own traversal and triangle test), peer-embree (one rtcIntersect1 per ray), peer-embree-stream (coherent row streams), gpu-raster (the GPU's pipeline through wgpu; lavapipe without a GPU) beside raycast and 3dr-full. Peers are not watertight: their pixels differing from 3dr-brute are reported, not asserted.</p>\n<table><tr><th class=\"l\">scene</th><th class=\"l\">algorithm</th><th>median ms</th><th>× 2dr-brute</th><th>Mrays/s</th><th>pixels ≠ 3dr-brute</th></tr>\n");
+    h.push_str("<h2 id=\"peers\">Peers</h2>\n<p>peer-obvhs (obvhs's own traversal and triangle test), peer-embree (one rtcIntersect1 per ray), peer-embree-stream (coherent row streams), gpu-raster (the GPU's pipeline through wgpu; lavapipe without a GPU) beside raycast and 3dr-full. Peers are not watertight: their pixels differing from 3dr-brute are reported, not asserted. Peers find the visible triangle and shade nothing; <em>visibility</em> is continuum's render without its shading stage, timed the same way.</p>\n<table><tr><th class=\"l\">scene</th><th class=\"l\">algorithm</th><th>median ms</th><th>× 2dr-brute</th><th>Mrays/s</th><th>visibility ms</th><th>visibility Mrays/s</th><th>pixels ≠ 3dr-brute</th></tr>\n");
     for group in groups(rows) {
         if !group.iter().any(|r| peer(r)) {
             continue;
@@ -242,12 +242,18 @@ fn peers(h: &mut String, rows: &[Row]) {
         {
             let _ = writeln!(
                 h,
-                "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{:.2}</td><td>{}</td><td>{:.2}</td><td>{}</td></tr>",
+                "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{:.2}</td><td>{}</td><td>{:.2}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
                 escape(&r.scene),
                 escape(&r.algorithm),
                 r.median_ms,
                 opt(r.ratio_to_2dr_brute, 2),
                 r.rays_per_second / 1e6,
+                opt(r.visibility_ms, 2),
+                opt(
+                    r.visibility_ms
+                        .map(|ms| f64::from(r.width) * f64::from(r.height) / ms / 1e3),
+                    2
+                ),
                 r.pixels_differing_from_3dr_brute
                     .map_or("–".into(), |d| d.to_string())
             );
