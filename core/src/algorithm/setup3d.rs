@@ -10,7 +10,10 @@ use super::tiles::Placed;
 use crate::aa::SampleSpan;
 use crate::camera::View;
 use crate::clip::{ClipPlane, clip_triangle};
-use crate::edge::{self, CurvedTriangle, Triangle3D, Triangle3D64};
+use crate::edge::{
+    CurvedTriangle, EightTriangles, HomogeneousVertex, Triangle3D, Triangle3D64,
+    setup_homogeneous_from,
+};
 use crate::prepared::PreparedScene;
 
 /// Every drawable triangle with samples on screen, set up with 3D edge functions.
@@ -43,23 +46,33 @@ pub(crate) fn setup_curved(
 
 /// Every drawable triangle with samples on screen, set up for homogeneous 2D
 /// rasterization (no clipping).
+/// Every vertex is transformed to homogeneous pixel coordinates once (as a
+/// vertex shader would), not once per triangle using it.
 pub(crate) fn setup_homogeneous<'a>(
     scene: &'a PreparedScene,
     view: &'a View,
     span: SampleSpan,
 ) -> Vec<Option<Placed<Triangle3D<'a>>>> {
-    setup_visible(scene, view, span, one_by_one(edge::setup_homogeneous))
+    let points: Vec<HomogeneousVertex> = (scene.scene.mesh.positions.par_iter())
+        .map(|&p| HomogeneousVertex::of(p, view))
+        .collect();
+    let setup = |t: &EightTriangles<'a>, view: &'a View| {
+        t.each(|l| {
+            let vertices = t.vertices[l].map(|v| points[v as usize]);
+            setup_homogeneous_from(t.corners[l], vertices, view)
+        })
+    };
+    setup_visible(scene, view, span, setup)
 }
 
-/// A setup of eight triangles at a time (bit `l` of the mask: lane `l` is
-/// to be set up), such as [`Triangle3D::setup_eight`].
+/// A setup of eight triangles at a time, such as [`Triangle3D::setup_eight`].
 pub(crate) trait SetupEight<'a, T>:
-    Fn([&'a [Vec3; 3]; 8], u8, &'a View) -> [Option<T>; 8] + Sync
+    Fn(&EightTriangles<'a>, &'a View) -> [Option<T>; 8] + Sync
 {
 }
 
-impl<'a, T, F: Fn([&'a [Vec3; 3]; 8], u8, &'a View) -> [Option<T>; 8] + Sync> SetupEight<'a, T>
-    for F
+impl<'a, T, F> SetupEight<'a, T> for F where
+    F: Fn(&EightTriangles<'a>, &'a View) -> [Option<T>; 8] + Sync
 {
 }
 
@@ -67,15 +80,7 @@ impl<'a, T, F: Fn([&'a [Vec3; 3]; 8], u8, &'a View) -> [Option<T>; 8] + Sync> Se
 pub(crate) fn one_by_one<'a, T>(
     setup: impl Fn(&'a [Vec3; 3], &'a View) -> Option<T> + Sync,
 ) -> impl SetupEight<'a, T> {
-    move |p: [&'a [Vec3; 3]; 8], present: u8, view: &'a View| {
-        let mut out = [const { None }; 8];
-        for l in 0..8 {
-            if present >> l & 1 == 1 {
-                out[l] = setup(p[l], view);
-            }
-        }
-        out
-    }
+    move |t: &EightTriangles<'a>, view: &'a View| t.each(|l| setup(t.corners[l], view))
 }
 
 /// A BVH slot's triangle's screen box and id (`None`: nothing to test).
@@ -107,7 +112,12 @@ pub(crate) fn setup_slots<'a, T: Send>(
     .zip(scene.slot_triangles.par_chunks(8))
     .map(|((p, vertices), ids)| {
         let (rects, present) = rects_of(p.len(), |l| boxes.rect(&p[l], vertices[l], view, span));
-        let triangles = setup(lanes_of(p), present, view);
+        let eight = EightTriangles {
+            corners: lanes_of(p),
+            vertices: lanes_of(vertices).map(|v| *v),
+            present,
+        };
+        let triangles = setup(&eight, view);
         let mut boxes = [None; 8];
         for l in 0..p.len() {
             if triangles[l].is_some() {
@@ -123,10 +133,10 @@ pub(crate) fn setup_slots<'a, T: Send>(
     SlotSetups { boxes, triangles }
 }
 
-/// Up to eight triangles as lanes (the last one repeated past the end).
+/// Up to eight values as lanes (the last one repeated past the end).
 #[inline]
-fn lanes_of(p: &[[Vec3; 3]]) -> [&[Vec3; 3]; 8] {
-    std::array::from_fn(|l| &p[l.min(p.len() - 1)])
+fn lanes_of<T>(v: &[T]) -> [&T; 8] {
+    std::array::from_fn(|l| &v[l.min(v.len() - 1)])
 }
 
 /// The screen boxes `rect(l)` of the first `n` lanes, and the mask of the
@@ -155,13 +165,18 @@ fn setup_visible<'a, T: Send>(
     let corners = &scene.scene.mesh.triangles;
     let placed: Vec<[Option<Placed<T>>; 8]> = (scene.drawable.par_chunks(8))
         .map(|ids| {
-            let p: [&[Vec3; 3]; 8] =
-                std::array::from_fn(|l| &scene.triangles[ids[l.min(ids.len() - 1)] as usize]);
+            let id = lanes_of(ids).map(|&id| id as usize);
+            let mut eight = EightTriangles {
+                corners: id.map(|id| &scene.triangles[id]),
+                vertices: id.map(|id| corners[id]),
+                present: 0,
+            };
             let (rects, present) = rects_of(ids.len(), |l| {
-                boxes.rect(p[l], corners[ids[l] as usize], view, span)
+                boxes.rect(eight.corners[l], eight.vertices[l], view, span)
             });
+            eight.present = present;
             let mut placed = [const { None }; 8];
-            for (l, tri) in setup(p, present, view).into_iter().enumerate() {
+            for (l, tri) in setup(&eight, view).into_iter().enumerate() {
                 if let (Some(tri), Some(rect)) = (tri, rects[l]) {
                     placed[l] = Some(Placed {
                         tri,

@@ -11,19 +11,19 @@
 
 use glam::Vec3;
 
+use super::EightTriangles;
 use super::edge3d::{EPS, ExactEdges, ExactForm, SCALE_ABOVE, Triangle3D, image_extent};
 use crate::camera::View;
 use crate::simd::{self, Lanes};
 
 impl<'a> Triangle3D<'a> {
-    /// The triangles `p` (lane `l` where bit `l` of `present` is set) set up
-    /// for `view`, each exactly as [`Triangle3D::setup`] sets it up.
+    /// The triangles of `t` set up for `view`, each exactly as
+    /// [`Triangle3D::setup`] sets it up.
     pub(crate) fn setup_eight(
-        p: [&'a [Vec3; 3]; 8],
-        present: u8,
+        t: &EightTriangles<'a>,
         view: &'a View,
     ) -> [Option<Triangle3D<'a>>; 8] {
-        setup_eight_with(p, present, view, perspective_lanes)
+        setup_eight_with(t.corners, t.present, view, perspective_lanes)
     }
 }
 

@@ -19,14 +19,32 @@ use crate::camera::View;
 /// A vertex in homogeneous pixel coordinates `(X, Y, W)`, `x = X/W`
 /// (orthographic: `W = 1`).
 pub(crate) fn homogeneous_point(p: Vec3, view: &View) -> Vec3 {
-    let (half_w, half_h) = (view.width as f32 * 0.5, view.height as f32 * 0.5);
-    let c = view.to_camera(p);
-    let w = if view.is_orthographic() { 1.0 } else { c.z };
-    Vec3::new(
-        (c.x / view.half_x + w) * half_w,
-        (w - c.y / view.half_y) * half_h,
-        w,
-    )
+    HomogeneousVertex::of(p, view).h
+}
+
+/// A vertex transformed for the homogeneous setup: its homogeneous pixel
+/// coordinates ([`homogeneous_point`]) and its view-axis distance `w`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct HomogeneousVertex {
+    h: Vec3,
+    w: f32,
+}
+
+impl HomogeneousVertex {
+    #[inline]
+    pub(crate) fn of(p: Vec3, view: &View) -> HomogeneousVertex {
+        let (half_w, half_h) = (view.width as f32 * 0.5, view.height as f32 * 0.5);
+        let c = view.to_camera(p);
+        let w = if view.is_orthographic() { 1.0 } else { c.z };
+        HomogeneousVertex {
+            h: Vec3::new(
+                (c.x / view.half_x + w) * half_w,
+                (w - c.y / view.half_y) * half_h,
+                w,
+            ),
+            w: c.z,
+        }
+    }
 }
 
 /// Setup of Fig. 10 (middle): transform, three cross products, determinant.
@@ -34,12 +52,21 @@ pub(crate) fn homogeneous_point(p: Vec3, view: &View) -> Vec3 {
 /// Orthographic views have `W = 1` at every vertex, and `w` is interpolated
 /// linearly: `w = Σ w_i·E_i / ΣE_i`.
 pub fn setup_homogeneous<'a>(p: &'a [Vec3; 3], view: &'a View) -> Option<Triangle3D<'a>> {
+    setup_homogeneous_from(p, p.map(|v| HomogeneousVertex::of(v, view)), view)
+}
+
+/// [`setup_homogeneous`] of the triangle `p` from its vertices, transformed.
+pub(crate) fn setup_homogeneous_from<'a>(
+    p: &'a [Vec3; 3],
+    vertices: [HomogeneousVertex; 3],
+    view: &'a View,
+) -> Option<Triangle3D<'a>> {
     // 1. Camera space → homogeneous pixel coordinates (X, Y, W), x = X/W.
     let orthographic = view.is_orthographic();
-    let cam = p.map(|v| view.to_camera(v));
+    let w = vertices.map(|v| v.w);
     // Far vertices scaled by a power of two (exact, no sign changes; see
     // `edge3d::scaled`): the rows are ~|h|², the determinant's products ~|h|³.
-    let (h, scale) = scaled(p.map(|v| homogeneous_point(v, view)));
+    let (h, scale) = scaled(vertices.map(|v| v.h));
     // 2. Edge functions: rows of the adjugate, c_i = h_{i+1} × h_{i+2}, written as
     //    midpoint × difference (equal in real arithmetic, as in §3.4 "Numerics"):
     //    the plain cross product of two long, nearly parallel vectors cancels
@@ -63,7 +90,7 @@ pub fn setup_homogeneous<'a>(p: &'a [Vec3; 3], view: &'a View) -> Option<Triangl
     // w is homogeneous of degree 1 in h (orthographic: 0, W = 1 and the rows
     // scale like the normal).
     let volume = if orthographic {
-        linear(rows[0] * cam[0].z + rows[1] * cam[1].z + rows[2] * cam[2].z)
+        linear(rows[0] * w[0] + rows[1] * w[1] + rows[2] * w[2])
     } else {
         [det.abs() * scale, 0.0, 0.0]
     };
@@ -78,7 +105,7 @@ pub fn setup_homogeneous<'a>(p: &'a [Vec3; 3], view: &'a View) -> Option<Triangl
         rows.map(linear),
         linear(normal),
         volume,
-        cam.map(|c| c.z),
+        w,
         view,
         coefficient_error,
         ExactEdges::new(ExactForm::Homogeneous, p, view, !positive),

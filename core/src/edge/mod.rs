@@ -27,6 +27,30 @@ pub use edge2d_fixed::Triangle2DFixed;
 pub use edge3d::Triangle3D;
 pub use edge3d_f64::Triangle3D64;
 pub use homogeneous::setup_homogeneous;
+pub(crate) use homogeneous::{HomogeneousVertex, setup_homogeneous_from};
+
+/// Up to eight triangles to set up together, one per lane: their corners,
+/// their mesh vertex indices, and which lanes hold one (bit `l`: lane `l`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct EightTriangles<'a> {
+    pub corners: [&'a [glam::Vec3; 3]; 8],
+    pub vertices: [[u32; 3]; 8],
+    pub present: u8,
+}
+
+impl EightTriangles<'_> {
+    /// `setup(l)` for each present lane `l`, `None` for the others.
+    #[inline]
+    pub(crate) fn each<T>(&self, mut setup: impl FnMut(usize) -> Option<T>) -> [Option<T>; 8] {
+        std::array::from_fn(|l| {
+            if self.present >> l & 1 == 1 {
+                setup(l)
+            } else {
+                None
+            }
+        })
+    }
+}
 
 use crate::simd::{Lanes, first_lanes};
 
