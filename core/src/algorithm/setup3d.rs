@@ -45,9 +45,8 @@ pub(crate) fn setup_curved(
 }
 
 /// Every drawable triangle with samples on screen, set up for homogeneous 2D
-/// rasterization (no clipping).
-/// Every vertex is transformed to homogeneous pixel coordinates once (as a
-/// vertex shader would), not once per triangle using it.
+/// rasterization (no clipping). Every vertex is transformed to homogeneous
+/// pixel coordinates once (as a vertex shader would), not once per triangle.
 pub(crate) fn setup_homogeneous<'a>(
     scene: &'a PreparedScene,
     view: &'a View,
@@ -105,28 +104,28 @@ pub(crate) fn setup_slots<'a, T: Send>(
     setup: impl SetupEight<'a, T>,
 ) -> SlotSetups<T> {
     let boxes = ScreenBoxes::new(scene, view);
-    let (boxes, triangles): (Vec<[SlotBox; 8]>, Vec<[Option<T>; 8]>) = (scene
-        .slot_corners
-        .par_chunks(8))
-    .zip(scene.slot_vertices.par_chunks(8))
-    .zip(scene.slot_triangles.par_chunks(8))
-    .map(|((p, vertices), ids)| {
-        let (rects, present) = rects_of(p.len(), |l| boxes.rect(&p[l], vertices[l], view, span));
-        let eight = EightTriangles {
-            corners: lanes_of(p),
-            vertices: lanes_of(vertices).map(|v| *v),
-            present,
-        };
-        let triangles = setup(&eight, view);
-        let mut boxes = [None; 8];
-        for l in 0..p.len() {
-            if triangles[l].is_some() {
-                boxes[l] = rects[l].map(|rect| (rect, ids[l]));
+    let chunks = (scene.slot_corners.par_chunks(8))
+        .zip(scene.slot_vertices.par_chunks(8))
+        .zip(scene.slot_triangles.par_chunks(8));
+    let (boxes, triangles): (Vec<[SlotBox; 8]>, Vec<[Option<T>; 8]>) = chunks
+        .map(|((p, vertices), ids)| {
+            let (rects, present) =
+                rects_of(p.len(), |l| boxes.rect(&p[l], vertices[l], view, span));
+            let eight = EightTriangles {
+                corners: lanes_of(p),
+                vertices: lanes_of(vertices).map(|v| *v),
+                present,
+            };
+            let triangles = setup(&eight, view);
+            let mut boxes = [None; 8];
+            for l in 0..p.len() {
+                if triangles[l].is_some() {
+                    boxes[l] = rects[l].map(|rect| (rect, ids[l]));
+                }
             }
-        }
-        (boxes, triangles)
-    })
-    .unzip();
+            (boxes, triangles)
+        })
+        .unzip();
     let (mut boxes, mut triangles) = (boxes.into_flattened(), triangles.into_flattened());
     boxes.truncate(scene.slot_triangles.len());
     triangles.truncate(scene.slot_triangles.len());
