@@ -15,7 +15,7 @@
 use glam::{Vec3, Vec3A};
 
 use crate::algorithm::PixelRect;
-use crate::algorithm::setup3d::ScreenBoxes;
+use crate::algorithm::screen_boxes::ScreenBoxes;
 use crate::binning::{SampleOracles, raster_triangle};
 use crate::bvh::{SlabRay, padded};
 use crate::camera::View;

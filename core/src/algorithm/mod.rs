@@ -14,6 +14,7 @@
 //! | `gpu-raster` | the wgpu hardware pipeline (feature `gpu`) | the driver's fixed-point rules |
 
 mod raycast;
+pub(crate) mod screen_boxes;
 pub(crate) mod setup2d;
 pub(crate) mod setup3d;
 pub(crate) mod tiles;
@@ -424,7 +425,7 @@ fn render_frusta<'a, T: crate::edge::Coverage>(
     setup: Setup<'a, T>,
 ) -> Pass {
     let start = Instant::now();
-    let boxes = setup3d::ScreenBoxes::new(scene, context.view);
+    let boxes = screen_boxes::ScreenBoxes::new(scene, context.view);
     let boxes = &boxes;
     let done: Vec<_> = fb
         .tile_rects(oracles.frustum)

@@ -24,6 +24,7 @@ mod homogeneous;
 pub use curved::CurvedTriangle;
 pub use edge2d::{ScreenVertex, Triangle2D};
 pub use edge2d_fixed::Triangle2DFixed;
+pub(crate) use edge3d::EPS;
 pub use edge3d::Triangle3D;
 pub use edge3d_f64::Triangle3D64;
 pub use homogeneous::setup_homogeneous;

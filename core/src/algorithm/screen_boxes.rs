@@ -1,0 +1,561 @@
+//! Conservative screen boxes for the 3D family (paper §3.2–3.3, §5 "3DR
+//! brute-force": the bounding box the samples are searched in).
+//!
+//! A 3D edge function decides coverage without projecting anything, so the box
+//! only bounds the search; but it must never cut off a sample the edge
+//! functions cover, or every 3D algorithm and the ray caster (which trust the
+//! same box) would lose it alike. What they cover is defined exactly: the ray
+//! `d(x, y) = d0 + x·dx + y·dy` (orthographic: from `o0 + x·ox + y·oy` along
+//! the view axis) in real arithmetic on the view's f32 coefficients, against
+//! the triangle whose vertices are the setup's f32 `p − eye`. So the box is
+//! the projection of those vertices through the exact inverse of that ray
+//! generator ([`ImageMap`]), padded by a certified bound on the rounding of
+//! that projection — thousandths of a pixel for ordinary views, and still
+//! correct for extreme zoom, where the image plane's f32 coefficients
+//! themselves are off by a tenth of a pixel from the camera's nominal one.
+
+use glam::{DMat3, DVec3, Vec3};
+use rayon::prelude::*;
+
+use super::PixelRect;
+use crate::aa::SampleSpan;
+use crate::camera::View;
+use crate::clip::{ClipPlane, clip_triangle};
+use crate::edge::EPS;
+use crate::prepared::PreparedScene;
+
+/// A conservative screen box for the part of the triangle at `w ≥ near`: the
+/// vertices (clipped at slightly less than `near` where the triangle reaches
+/// nearer) projected through the ray generator's inverse. Non-planar
+/// viewports: the bounds of the triangle's cap of directions
+/// ([`crate::camera::SphereMap::bounds_of`]), padded by a pixel. The pixels
+/// returned are those with a sample (at offsets `span`) in the box.
+pub(crate) fn screen_rect(p: &[Vec3; 3], view: &View, span: SampleSpan) -> Option<PixelRect> {
+    if let Some(map) = &view.sphere {
+        let [x0, y0, x1, y1] = map.bounds_of(&p.map(|v| view.to_camera_f64(v)));
+        return PixelRect::from_bounds(
+            (x0 - 1.0) as f32,
+            (y0 - 1.0) as f32,
+            (x1 + 1.0) as f32,
+            (y1 + 1.0) as f32,
+            view.width,
+            view.height,
+            span,
+        );
+    }
+    let map = ImageMap::new(view);
+    map.image_box(p, &p.map(|v| map.point(v - view.eye)), view)?
+        .pixels(view, span)
+}
+
+/// Triangles reaching nearer than this are clipped for their screen box:
+/// slightly less than `near`, so rounding never cuts off a sample at `near`.
+fn near_bound(view: &View) -> f32 {
+    view.near * (1.0 - 1.0 / 1024.0)
+}
+
+/// The inverse of a planar view's ray generator, `G(q) = M⁻¹·q` with
+/// `M = [dx | dy | d0]` (perspective; `q` relative to the eye) or
+/// `M = [ox | oy | d_p]` (orthographic; `q` relative to the ray origin at
+/// image point (0, 0)): a point `q = c·d(x, y)` (orthographic
+/// `q = o(x, y) + c·d_p`) has `G(q) = (c·x, c·y, c)` (orthographic
+/// `(x, y, c)`), `c` its depth along the ray. Exact in real arithmetic
+/// against the f32 coefficients the edge functions use, so the projection
+/// and the coverage test agree on where every point is.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ImageMap {
+    /// Rows of `M⁻¹` (computed in f64, rounded once), with their absolute values.
+    rows: [Vec3; 3],
+    rows_abs: [Vec3; 3],
+    rows64: [DVec3; 3],
+    /// Orthographic: the ray origin at image point (0, 0) relative to the eye.
+    origin: Option<Vec3>,
+    /// The view axis: the setups' vertex depths are `(p − eye)·forward` in f32.
+    forward: Vec3,
+    near_bound: f32,
+}
+
+/// Where a vertex lands on the image.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum ImagePoint {
+    /// Certainly at depth `≥ near_bound`: its image point and a bound on the
+    /// rounding of both coordinates.
+    Projected { x: f32, y: f32, pad: f32 },
+    /// Certainly nearer than `near_bound`.
+    Nearer,
+    /// Too close to `near_bound` to tell in f32: the triangle takes the
+    /// clipped f64 path.
+    Unsure,
+}
+
+impl ImageMap {
+    pub(crate) fn new(view: &View) -> ImageMap {
+        let (columns, origin) = if view.is_orthographic() {
+            ([view.ox, view.oy, view.forward], Some(view.o0))
+        } else {
+            ([view.dx, view.dy, view.d0], None)
+        };
+        let m = DMat3::from_cols(
+            columns[0].as_dvec3(),
+            columns[1].as_dvec3(),
+            columns[2].as_dvec3(),
+        );
+        // Rows of the inverse: the columns of its transpose.
+        let inverse = m.inverse().transpose();
+        let rows64 = [inverse.x_axis, inverse.y_axis, inverse.z_axis];
+        let rows = rows64.map(|r| r.as_vec3());
+        ImageMap {
+            rows,
+            rows_abs: rows.map(Vec3::abs),
+            rows64,
+            origin,
+            forward: view.forward,
+            near_bound: near_bound(view),
+        }
+    }
+
+    /// The image point of the vertex `q = p − eye` (rounded in f32 exactly as
+    /// the setup rounds it), with a certified bound on its rounding error.
+    /// [`ImagePoint::Nearer`] only when the setups' own depth of the vertex,
+    /// `(p − eye)·forward` (in f32 or f64), is certainly below the bound too:
+    /// a triangle whose vertices all are has every sample's depth (clamped
+    /// into the vertices' range) below `near`.
+    ///
+    /// The f64 setups take `p − eye` exactly: `q` is off from it by at most
+    /// `ε·|q|`, which the bound below covers as well, so the point holds for
+    /// both.
+    ///
+    /// Each coordinate of `G(q)` is a 3-term dot product: off from the exact
+    /// one by at most `γ₃·|r|·|q|` plus `ε·|r|·|q|` for the row's own rounding
+    /// and `ε·|r|·|q|` for `q`'s (orthographic: one more `ε` for `q − o0`),
+    /// `< 6ε·|r|·|q|`; bounded as
+    /// `16ε·|r|·|q|`. Perspective divides: with `a, c` off by `α, β`,
+    /// `a/c − a₀/c₀ = (α − x₀·β)/c`, and the quotient rounds by `ε·|x|`. The
+    /// bound doubles that and adds `8ε·|x|` so that the box's pixel bounds,
+    /// rounded again from it, still hold every sample inside.
+    #[inline]
+    pub(crate) fn point(&self, q: Vec3) -> ImagePoint {
+        let setup_w = q.dot(self.forward);
+        let (q, q_abs) = match self.origin {
+            Some(o0) => (q - o0, q.abs() + o0.abs()),
+            None => (q, q.abs()),
+        };
+        let [ra, rb, rc] = self.rows;
+        let (a, b, c) = (ra.dot(q), rb.dot(q), rc.dot(q));
+        let [sa, sb, sc] = self.rows_abs.map(|r| r.dot(q_abs) * (16.0 * EPS));
+        if c + sc < self.near_bound && setup_w + sc < self.near_bound {
+            return ImagePoint::Nearer;
+        }
+        if !(c - sc >= self.near_bound && c - sc > 0.0) {
+            return ImagePoint::Unsure;
+        }
+        let (x, y, pad) = if self.origin.is_some() {
+            (a, b, sa.max(sb))
+        } else {
+            let (x, y) = (a / c, b / c);
+            let off = |v: f32, s: f32| 2.0 * (s + (v.abs() + s / c) * sc) / c;
+            (x, y, off(x, sa).max(off(y, sb)))
+        };
+        let pad = pad + 8.0 * EPS * x.abs().max(y.abs()) + 1.0 / (1 << 20) as f32;
+        if !(x.is_finite() && y.is_finite() && pad.is_finite()) {
+            return ImagePoint::Unsure;
+        }
+        ImagePoint::Projected { x, y, pad }
+    }
+
+    /// The box of the triangle `p` with vertex image points `points`: theirs
+    /// when all three are projected; `None` when all three are nearer than
+    /// the bound (so is every point of the triangle, which has no sample at
+    /// `w ≥ near`); else the clipped f64 box.
+    #[inline]
+    fn image_box(&self, p: &[Vec3; 3], points: &[ImagePoint; 3], view: &View) -> Option<ImageBox> {
+        if points.iter().all(|p| *p == ImagePoint::Nearer) {
+            return None;
+        }
+        ImageBox::of(points).or_else(|| self.clipped_box(p, view))
+    }
+
+    /// The box of the part of the triangle where a sample can pass the near
+    /// test, in f64, for both geometries a setup may take the triangle in:
+    /// `p − eye` rounded to f32 (the f32 setups) and exact (the f64 ones),
+    /// which on extreme zoom differ by pixels. Per geometry: each vertex
+    /// mapped through `G`, the polygon clipped at depth `c ≥ near_bound`
+    /// lowered by how far `c` and the setup's own vertex depth may differ at
+    /// a vertex (both are linear over the triangle, so the vertices bound
+    /// their difference everywhere: a sample lifted to `near` by the clamp to
+    /// the vertices' depth range is kept too), its corners projected. Padded
+    /// by 1/16 pixel plus a relative 2⁻¹⁶ (far more than f64 rounding).
+    /// `None` when nothing of it is that far; the whole image when the
+    /// lowered plane reaches the eye.
+    fn clipped_box(&self, p: &[Vec3; 3], view: &View) -> Option<ImageBox> {
+        let origin = self.origin.unwrap_or(Vec3::ZERO).as_dvec3();
+        let forward = self.forward.as_dvec3();
+        let [ra, rb, rc] = self.rows64;
+        let rounded = p.map(|v| {
+            let q = v - view.eye;
+            (q.as_dvec3(), f64::from(q.dot(self.forward)))
+        });
+        let exact = p.map(|v| {
+            let q = v.as_dvec3() - view.eye.as_dvec3();
+            (q, q.dot(forward))
+        });
+        let mut image_box: Option<ImageBox> = None;
+        for geometry in [rounded, exact] {
+            let mut slack = 0.0f64;
+            let g = geometry.map(|(q, setup_w)| {
+                let q = q - origin;
+                let g = DVec3::new(ra.dot(q), rb.dot(q), rc.dot(q));
+                slack = slack.max((g.z - setup_w).abs() + 1e-9 * q.abs().max_element());
+                g
+            });
+            let plane = f64::from(self.near_bound) - slack;
+            if plane.is_nan() || plane <= 0.0 {
+                return Some(ImageBox::EVERYWHERE);
+            }
+            let Some(poly) = clip_triangle(g, &[ClipPlane::near(plane)]) else {
+                continue;
+            };
+            let part = image_box.get_or_insert(ImageBox::EMPTY);
+            for &g in poly.as_slice() {
+                let (x, y) = match self.origin {
+                    Some(_) => (g.x, g.y),
+                    None => (g.x / g.z, g.y / g.z),
+                };
+                part.grow(x as f32, y as f32, 0.0);
+            }
+        }
+        let mut image_box = image_box?;
+        image_box.pad = 1.0 / 16.0 + image_box.magnitude() / 65536.0;
+        Some(image_box)
+    }
+}
+
+/// [`screen_rect`] of every triangle of one view, with planar views'
+/// vertices projected once (not once per triangle using them).
+pub(crate) struct ScreenBoxes {
+    map: Option<ImageMap>,
+    points: Vec<ImagePoint>,
+}
+
+impl ScreenBoxes {
+    pub(crate) fn new(scene: &PreparedScene, view: &View) -> ScreenBoxes {
+        ScreenBoxes::of(&scene.scene.mesh.positions, view)
+    }
+
+    /// The boxes of triangles over mesh vertices `positions`.
+    fn of(positions: &[Vec3], view: &View) -> ScreenBoxes {
+        let map = view.sphere.is_none().then(|| ImageMap::new(view));
+        let points = match &map {
+            Some(map) => (positions.par_iter())
+                .map(|&p| map.point(p - view.eye))
+                .collect(),
+            None => Vec::new(),
+        };
+        ScreenBoxes { map, points }
+    }
+
+    /// [`screen_rect`] of the triangle with positions `p` at mesh vertices
+    /// `vertices` (planar views read the vertices' projections).
+    #[inline]
+    pub(crate) fn rect(
+        &self,
+        p: &[Vec3; 3],
+        vertices: [u32; 3],
+        view: &View,
+        span: SampleSpan,
+    ) -> Option<PixelRect> {
+        let Some(map) = &self.map else {
+            return screen_rect(p, view, span);
+        };
+        let points = vertices.map(|v| self.points[v as usize]);
+        map.image_box(p, &points, view)?.pixels(view, span)
+    }
+}
+
+/// A box of image points, padded.
+#[derive(Clone, Copy, Debug)]
+struct ImageBox {
+    min: [f32; 2],
+    max: [f32; 2],
+    pad: f32,
+}
+
+impl ImageBox {
+    const EMPTY: ImageBox = ImageBox {
+        min: [f32::INFINITY; 2],
+        max: [f32::NEG_INFINITY; 2],
+        pad: 0.0,
+    };
+
+    /// Every image point.
+    const EVERYWHERE: ImageBox = ImageBox {
+        min: [f32::NEG_INFINITY; 2],
+        max: [f32::INFINITY; 2],
+        pad: 0.0,
+    };
+
+    /// The box of three projected vertices, padded by the largest of their
+    /// bounds; `None` unless all three are [`ImagePoint::Projected`].
+    #[inline]
+    fn of(points: &[ImagePoint; 3]) -> Option<ImageBox> {
+        let mut image_box = ImageBox::EMPTY;
+        for point in points {
+            let ImagePoint::Projected { x, y, pad } = *point else {
+                return None;
+            };
+            image_box.grow(x, y, pad);
+        }
+        Some(image_box)
+    }
+
+    #[inline]
+    fn grow(&mut self, x: f32, y: f32, pad: f32) {
+        self.min = [self.min[0].min(x), self.min[1].min(y)];
+        self.max = [self.max[0].max(x), self.max[1].max(y)];
+        self.pad = self.pad.max(pad);
+    }
+
+    fn magnitude(&self) -> f32 {
+        let (min, max) = (self.min, self.max);
+        min[0]
+            .abs()
+            .max(min[1].abs())
+            .max(max[0].abs())
+            .max(max[1].abs())
+    }
+
+    /// The pixels with a sample in the padded box.
+    #[inline]
+    fn pixels(self, view: &View, span: SampleSpan) -> Option<PixelRect> {
+        let (min, max, pad) = (self.min, self.max, self.pad);
+        PixelRect::from_bounds(
+            min[0] - pad,
+            min[1] - pad,
+            max[0] + pad,
+            max[1] + pad,
+            view.width,
+            view.height,
+            span,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DVec3, Vec3};
+
+    use super::*;
+    use crate::aa::{AaMode, SamplePattern};
+    use crate::camera::Camera;
+    use crate::edge::{Coverage, Triangle3D64};
+    use crate::viewport::Viewport;
+
+    fn view(eye: Vec3, target: Vec3, viewport: Viewport, size: (u32, u32), near: f32) -> View {
+        let camera = Camera {
+            name: "test".into(),
+            eye,
+            target,
+            up: Vec3::Y,
+            viewport,
+            near: Some(near),
+        };
+        View::new(&camera, size.0, size.1, near).expect("a valid camera")
+    }
+
+    /// A point (rounded to f32) at depth `t` on the ray of image point
+    /// `(x, y)`, computed in f64: within rounding of that sample's ray, where
+    /// rounding decides whether the sample is covered.
+    fn on_ray(view: &View, x: f32, y: f32, t: f64) -> Vec3 {
+        let (x, y) = (f64::from(x), f64::from(y));
+        let origin = view.eye.as_dvec3()
+            + view.o0.as_dvec3()
+            + view.ox.as_dvec3() * x
+            + view.oy.as_dvec3() * y;
+        (origin + view.direction_f64(x, y) * t).as_vec3()
+    }
+
+    /// Every sample the 3D edge functions cover lies in the triangle's screen
+    /// box, on views that stress the box's rounding bound:
+    /// extreme zoom, 16384-pixel images, cameras far from the origin,
+    /// orthographic views, triangles crossing the near plane, and vertices
+    /// placed on sample rays (where rounding alone decides coverage).
+    /// Coverage as the f64 setup decides it: inside the edges exactly (as
+    /// in f32) and at `w ≥ near` by an f64 depth — on such views the f32
+    /// depth of a triangle crossing the eye plane can be far off, and the
+    /// box's clipping at `near` is what keeps those samples out.
+    #[test]
+    fn screen_boxes_hold_every_covered_sample() {
+        let mut rng = fastrand::Rng::with_seed(11);
+        let (mut covered, mut boxes) = (0u64, 0u64);
+        for case in 0..400 {
+            let far = [0.0, 1e3, 3e5][case % 3];
+            let eye = Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5) * 4.0
+                + Vec3::splat(far);
+            let target = eye + Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, -1.0);
+            let viewport = match case % 6 {
+                0 => Viewport::Orthographic {
+                    height: [1e-3, 1.0, 50.0][rng.usize(0..3)],
+                },
+                _ => Viewport::Perspective {
+                    fov_y_deg: [0.05, 0.5, 10.0, 60.0, 120.0, 170.0][rng.usize(0..6)],
+                },
+            };
+            let size = match case % 4 {
+                0 => (16384, 9),
+                1 => (9, 16384),
+                _ => (rng.u32(1..200), rng.u32(1..200)),
+            };
+            let near = [1e-3, 0.1, 1.0][rng.usize(0..3)];
+            let view = view(eye, target, viewport, size, near);
+            let scale = match viewport {
+                Viewport::Orthographic { height } => f64::from(height),
+                _ => 1.0,
+            };
+            let aa = [
+                AaMode::None,
+                AaMode::Ssaa(16),
+                AaMode::Csaa {
+                    coverage: 8,
+                    stored: 4,
+                },
+            ];
+            let pattern = SamplePattern::of(aa[rng.usize(0..3)]);
+            // Triangles: one vertex on a sample's ray, the others a few pixels
+            // (or a fraction of one) away, at depths around and across `near`.
+            let mut positions = Vec::new();
+            for _ in 0..24 {
+                let pixel = |rng: &mut fastrand::Rng, n: u32| rng.u32(0..n) as f32;
+                let (px, py) = (pixel(&mut rng, view.width), pixel(&mut rng, view.height));
+                let [ox, oy] = pattern.positions[rng.usize(0..pattern.positions.len())];
+                let depth = |rng: &mut fastrand::Rng| {
+                    let base = f64::from(near) * [0.999, 1.0, 1.001, 2.0, 100.0][rng.usize(0..5)];
+                    if rng.u32(0..6) == 0 {
+                        -base
+                    } else {
+                        base * (0.5 + rng.f64())
+                    }
+                };
+                let spread = [0.3, 2.0, 40.0][rng.usize(0..3)];
+                let mut corner = |x: f32, y: f32, rng: &mut fastrand::Rng| {
+                    let t = depth(rng) * scale.max(1.0) / scale.max(1.0);
+                    positions.push(on_ray(&view, x, y, t));
+                };
+                corner(px + ox, py + oy, &mut rng);
+                for _ in 0..2 {
+                    let (dx, dy) = ((rng.f32() - 0.5) * spread, (rng.f32() - 0.5) * spread);
+                    corner(px + ox + dx, py + oy + dy, &mut rng);
+                }
+            }
+            let screen = ScreenBoxes::of(&positions, &view);
+            for (k, tri) in positions.chunks_exact(3).enumerate() {
+                let p: [Vec3; 3] = [tri[0], tri[1], tri[2]];
+                let vertices = [3 * k as u32, 3 * k as u32 + 1, 3 * k as u32 + 2];
+                let rect = screen.rect(&p, vertices, &view, pattern.span);
+                assert_eq!(
+                    rect,
+                    screen_rect(&p, &view, pattern.span),
+                    "one box, both entry points"
+                );
+                boxes += u64::from(rect.is_some());
+                // Coverage is only meaningful where the orientation is: skip
+                // triangles so nearly edge-on that f64 cannot tell (the f64
+                // setup has no exact fallback; the f32 one decides exactly).
+                let q = p.map(|v| v.as_dvec3() - view.eye.as_dvec3());
+                let volume = (q[1] - q[0]).cross(q[2] - q[0]).dot(q[0]);
+                let scale = q[0].length() * q[1].length() * q[2].length();
+                if volume.is_nan() || volume.abs() <= 1e-12 * scale {
+                    continue;
+                }
+                let f64_setup = Triangle3D64::setup(&p, &view);
+                // Pixels to test: the box and two pixels around it, and around
+                // each vertex's projection (so a box that is missing or too
+                // small is caught), all of them on small images.
+                let mut regions: Vec<[u32; 4]> = Vec::new();
+                let clamp = |x0: f64, y0: f64, x1: f64, y1: f64| {
+                    let w = f64::from(view.width - 1);
+                    let h = f64::from(view.height - 1);
+                    [
+                        x0.clamp(0.0, w) as u32,
+                        y0.clamp(0.0, h) as u32,
+                        x1.clamp(0.0, w) as u32,
+                        y1.clamp(0.0, h) as u32,
+                    ]
+                };
+                if u64::from(view.width) * u64::from(view.height) <= 40_000 {
+                    regions.push([0, 0, view.width - 1, view.height - 1]);
+                } else {
+                    if let Some(r) = rect {
+                        regions.push(clamp(
+                            f64::from(r.x0) - 2.0,
+                            f64::from(r.y0) - 2.0,
+                            f64::from(r.x1) + 2.0,
+                            f64::from(r.y1) + 2.0,
+                        ));
+                    }
+                    for v in p {
+                        let c: DVec3 = view.to_camera_f64(v);
+                        if view.is_orthographic() || c.z > 0.0 {
+                            let (x, y) = view.project_f64(c);
+                            regions.push(clamp(x - 3.0, y - 3.0, x + 3.0, y + 3.0));
+                        }
+                    }
+                }
+                for [x0, y0, x1, y1] in regions {
+                    for py in y0..=y1 {
+                        for px in x0..=x1 {
+                            for &[ox, oy] in &pattern.positions {
+                                let (sx, sy) = (px as f32 + ox, py as f32 + oy);
+                                let hit = f64_setup
+                                    .as_ref()
+                                    .is_some_and(|t| t.sample(sx, sy).is_some());
+                                if !hit {
+                                    continue;
+                                }
+                                covered += 1;
+                                let inside = rect.is_some_and(|r| {
+                                    (r.x0..=r.x1).contains(&px) && (r.y0..=r.y1).contains(&py)
+                                });
+                                assert!(
+                                    inside,
+                                    "case {case}: sample ({sx}, {sy}) of {p:?} is covered but outside {rect:?} ({view:?})"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        // The test must have tested something.
+        assert!(
+            covered > 10_000 && boxes > 3_000,
+            "{covered} covered samples, {boxes} boxes"
+        );
+    }
+
+    /// On an ordinary view the bound is thousandths of a pixel (the box of
+    /// a sub-pixel triangle is not inflated to its neighbours' samples).
+    #[test]
+    fn the_rounding_bound_is_small_on_ordinary_views() {
+        let view = view(
+            Vec3::new(0.0, 1.0, 5.0),
+            Vec3::ZERO,
+            Viewport::Perspective { fov_y_deg: 60.0 },
+            (1920, 1080),
+            0.01,
+        );
+        let map = ImageMap::new(&view);
+        let mut rng = fastrand::Rng::with_seed(5);
+        for _ in 0..10_000 {
+            let (x, y) = (rng.f32() * 1920.0, rng.f32() * 1080.0);
+            let q = on_ray(&view, x, y, 0.1 + 10.0 * rng.f64()) - view.eye;
+            let ImagePoint::Projected { x: px, y: py, pad } = map.point(q) else {
+                panic!("({x}, {y}) is in front of the camera");
+            };
+            assert!(pad < 0.01, "pad {pad} at ({x}, {y})");
+            assert!(
+                (px - x).abs() < 0.01 && (py - y).abs() < 0.01,
+                "({px}, {py}) for ({x}, {y})"
+            );
+        }
+    }
+}
