@@ -379,10 +379,10 @@ mod tests {
     /// extreme zoom, 16384-pixel images, cameras far from the origin,
     /// orthographic views, triangles crossing the near plane, and vertices
     /// placed on sample rays (where rounding alone decides coverage).
-    /// Coverage as the f64 setup decides it: inside the edges exactly (as
-    /// in f32) and at `w ≥ near` by an f64 depth — on such views the f32
-    /// depth of a triangle crossing the eye plane can be far off, and the
-    /// box's clipping at `near` is what keeps those samples out.
+    /// Coverage as the f64 setup decides it (edges and depth in f64): on
+    /// such views the f32 depth of a triangle crossing the eye plane can be
+    /// far off, and the box's clipping at `near` is what keeps those
+    /// samples out.
     #[test]
     fn screen_boxes_hold_every_covered_sample() {
         let mut rng = fastrand::Rng::with_seed(11);
@@ -407,10 +407,6 @@ mod tests {
             };
             let near = [1e-3, 0.1, 1.0][rng.usize(0..3)];
             let view = view(eye, target, viewport, size, near);
-            let scale = match viewport {
-                Viewport::Orthographic { height } => f64::from(height),
-                _ => 1.0,
-            };
             let aa = [
                 AaMode::None,
                 AaMode::Ssaa(16),
@@ -437,8 +433,7 @@ mod tests {
                 };
                 let spread = [0.3, 2.0, 40.0][rng.usize(0..3)];
                 let mut corner = |x: f32, y: f32, rng: &mut fastrand::Rng| {
-                    let t = depth(rng) * scale.max(1.0) / scale.max(1.0);
-                    positions.push(on_ray(&view, x, y, t));
+                    positions.push(on_ray(&view, x, y, depth(rng)));
                 };
                 corner(px + ox, py + oy, &mut rng);
                 for _ in 0..2 {
