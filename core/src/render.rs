@@ -1,6 +1,7 @@
 //! The one entry point every front end calls: `render(&PreparedScene,
 //! &RenderRequest) -> RenderOutput`.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -57,9 +58,15 @@ impl From<FieldError> for RenderError {
 
 impl From<CameraError> for RenderError {
     fn from(e: CameraError) -> Self {
+        if e.field == "size" {
+            return RenderError {
+                field: "size",
+                message: e.message,
+            };
+        }
         RenderError {
-            field: if e.field == "size" { "size" } else { "camera" },
-            message: e.to_string(),
+            field: "camera",
+            message: format!("{}: {}", e.field, e.message),
         }
     }
 }
@@ -113,6 +120,17 @@ impl RenderOutput {
 
 /// Renders `scene` as `request` asks.
 pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOutput, RenderError> {
+    render_cancellable(scene, request, &AtomicBool::new(false))
+}
+
+/// [`render`], abandoned when `cancel` becomes true (checked once per tile or
+/// band of rows, so a render stops within one tile's time of being
+/// cancelled): then the answer is an error naming `cancelled`.
+pub fn render_cancellable(
+    scene: &PreparedScene,
+    request: &RenderRequest,
+    cancel: &AtomicBool,
+) -> Result<RenderOutput, RenderError> {
     let total = Instant::now();
     if request.width == 0
         || request.height == 0
@@ -184,6 +202,7 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
             pattern: &pattern,
             shader,
             opacity: &scene.triangle_opacity,
+            cancel,
         };
         algorithm::run(
             pipeline,
@@ -193,6 +212,12 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
             &mut fb,
             &mut stats,
         );
+    }
+    if cancel.load(Ordering::Relaxed) {
+        return Err(RenderError {
+            field: "cancelled",
+            message: "the render was cancelled before it finished".into(),
+        });
     }
 
     (stats.edge_evaluations, stats.max_edge_evals_per_pixel) = fb
@@ -223,6 +248,27 @@ pub fn render(scene: &PreparedScene, request: &RenderRequest) -> Result<RenderOu
         stats,
         hashes,
     })
+}
+
+/// Why this process cannot run `algorithm` on this machine, or `None` when it
+/// can: `gpu-raster` needs the `gpu` feature and a device that renders its
+/// formats (opened on first ask). Front ends list, grey out or skip what this
+/// names; a render of it fails with the same message.
+pub fn unavailable(algorithm: AlgorithmId) -> Option<String> {
+    match algorithm.pipeline() {
+        Pipeline::Gpu => gpu_unavailable(),
+        _ => None,
+    }
+}
+
+#[cfg(feature = "gpu")]
+fn gpu_unavailable() -> Option<String> {
+    crate::gpu::gpu().err().map(|e| e.to_string())
+}
+
+#[cfg(not(feature = "gpu"))]
+fn gpu_unavailable() -> Option<String> {
+    Some("gpu-raster needs continuum built with the `gpu` feature".into())
 }
 
 /// `gpu-raster`: one sample per pixel through the hardware pipeline.
@@ -267,6 +313,6 @@ fn render_on_gpu(
 ) -> Result<(), RenderError> {
     Err(RenderError {
         field: "algorithm",
-        message: "gpu-raster needs continuum built with the `gpu` feature".into(),
+        message: gpu_unavailable().unwrap_or_default(),
     })
 }

@@ -112,7 +112,7 @@ impl CameraSpec {
         };
         camera
             .validate()
-            .map_err(|e| FieldError::new("camera", e.to_string()))?;
+            .map_err(|e| FieldError::new("camera", format!("{}: {}", e.field, e.message)))?;
         Ok(camera)
     }
 }

@@ -156,6 +156,11 @@ pub struct RasterCounters {
     pub nodes_culled_outside: u64,
     /// BVH nodes culled because the hierarchical w-buffer hides them.
     pub nodes_culled_occluded: u64,
+    /// 3D edge tests within the f32 rounding bound of zero, decided again in
+    /// f64 (README: "Precision and exactness").
+    pub edge_tests_f64: u64,
+    /// Of those, the ones f64 could not decide either: decided exactly.
+    pub edge_tests_exact: u64,
 }
 
 impl std::ops::AddAssign for RasterCounters {
@@ -170,5 +175,7 @@ impl std::ops::AddAssign for RasterCounters {
         self.frusta_split += o.frusta_split;
         self.nodes_culled_outside += o.nodes_culled_outside;
         self.nodes_culled_occluded += o.nodes_culled_occluded;
+        self.edge_tests_f64 += o.edge_tests_f64;
+        self.edge_tests_exact += o.edge_tests_exact;
     }
 }

@@ -15,9 +15,7 @@ pub struct RenderArgs {
     /// A built-in scene name, or a .toml, .gltf, .glb or .obj path.
     #[arg(long)]
     scene: String,
-    /// Algorithm id: 2dr-brute, 2dr-bin, 2dr-homogeneous, 3dr-brute, 3dr-bin,
-    /// 3dr-frustum-cull, 3dr-frustum-split, 3dr-full or raycast.
-    #[arg(long, value_parser = |s: &str| parse_algorithm(s).map_err(|e| e.message))]
+    #[arg(long, help = crate::help::algorithms(), value_parser = |s: &str| parse_algorithm(s).map_err(|e| e.message))]
     algorithm: AlgorithmId,
     /// A camera of the scene (by name); default: the scene's first camera.
     #[arg(long)]
@@ -30,8 +28,7 @@ pub struct RenderArgs {
     /// (default: the camera's own; bare words keep its field of view or height).
     #[arg(long)]
     viewport: Option<String>,
-    /// Anti-aliasing mode: none, ssaa:N (4|16|64|256), msaa:N (2|4|8|16), csaa:CxS (e.g. 16x4).
-    #[arg(long, default_value = "none")]
+    #[arg(long, default_value = "none", help = crate::help::aa_modes())]
     aa: String,
     /// Precision of coverage decisions: f32, f64 (3D family) or fixed (2D
     /// family: vertices snapped to 1/256 pixel, exact integer edge functions).
@@ -56,6 +53,9 @@ pub struct RenderArgs {
     /// Folder of built-in scenes.
     #[arg(long)]
     scenes: Option<PathBuf>,
+    /// Worker threads [default: all cores].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    threads: Option<u32>,
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
@@ -88,7 +88,14 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         precision: args.precision,
         texture_filter: args.texture_filter,
     };
-    let out = render(&prepared, &request).map_err(|e| CliError::Usage(format!("--{e}")))?;
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(t) = args.threads {
+        pool = pool.num_threads(t as usize);
+    }
+    let pool = pool.build().context("building the thread pool")?;
+    let out = pool
+        .install(|| render(&prepared, &request))
+        .map_err(|e| CliError::Usage(format!("--{e}")))?;
 
     if let Some(path) = &args.out {
         std::fs::write(path, maps::png_bytes(&maps::color_image(&out.framebuffer)))

@@ -33,7 +33,7 @@ impl ApiError {
         ApiError {
             status: StatusCode::SERVICE_UNAVAILABLE,
             error: "all render workers are busy; retry shortly".into(),
-            field: None,
+            field: Some("queue".into()),
         }
     }
 
@@ -58,7 +58,37 @@ impl ApiError {
         ApiError {
             status: StatusCode::INTERNAL_SERVER_ERROR,
             error: error.into(),
-            field: None,
+            field: Some("server".into()),
+        }
+    }
+
+    /// A route that exists, asked with another method.
+    pub fn method_not_allowed() -> ApiError {
+        ApiError::with_status(
+            StatusCode::METHOD_NOT_ALLOWED,
+            Some("method"),
+            "this route does not take that method (GET reads, POST renders or uploads)",
+        )
+    }
+
+    /// Checks that a JSON endpoint's body says it is JSON (`application/json`,
+    /// parameters such as `charset` allowed).
+    pub fn require_json(headers: &axum::http::HeaderMap) -> Result<(), ApiError> {
+        let kind = headers
+            .get(header::CONTENT_TYPE)
+            .and_then(|v| v.to_str().ok())
+            .unwrap_or("");
+        let essence = kind.split(';').next().unwrap_or("").trim();
+        if essence.eq_ignore_ascii_case("application/json") {
+            Ok(())
+        } else {
+            Err(ApiError::with_status(
+                StatusCode::UNSUPPORTED_MEDIA_TYPE,
+                Some("content-type"),
+                format!(
+                    "the body must be JSON sent as content-type application/json, not '{kind}'"
+                ),
+            ))
         }
     }
 }

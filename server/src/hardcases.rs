@@ -73,6 +73,7 @@ pub fn run(args: &HardcasesArgs) -> Result<bool, CliError> {
             "cases": report.cases,
             "table": table_json(&report),
             "checks": report.checks,
+            "not_run": report.not_run.iter().map(|(a, why)| json!({ "algorithm": a, "reason": why })).collect::<Vec<_>>(),
         });
         let text = serde_json::to_string_pretty(&doc).context("encoding JSON")?;
         write_stdout(&(text + "\n"))?;
@@ -104,6 +105,7 @@ fn tally(report: &SuiteReport) -> BTreeMap<(String, String), (u64, u64)> {
 fn columns() -> Vec<String> {
     hardcases::variants_of_all()
         .into_iter()
+        .filter(|(a, _)| continuum::unavailable(*a).is_none())
         .map(|(a, p)| hardcases::variant_name(a, p))
         .collect()
 }
@@ -181,6 +183,9 @@ fn table_text(report: &SuiteReport) -> String {
     writeln!(out).ok();
     for (k, col) in cols.iter().enumerate() {
         writeln!(out, "c{k:<3} {col}").ok();
+    }
+    for (a, why) in &report.not_run {
+        writeln!(out, "not run on this machine: {a} ({why})").ok();
     }
     let mut limits: Vec<(&str, String, &str)> = report
         .checks

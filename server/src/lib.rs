@@ -40,6 +40,7 @@ pub fn app(state: Arc<AppState>) -> Router {
         .route("/api/render.png", get(render_api::render_png))
         .route("/metrics", get(metrics::metrics))
         .fallback(|| async { ApiError::not_found("path", "no such route") })
+        .method_not_allowed_fallback(|| async { ApiError::method_not_allowed() })
         .layer(axum::extract::DefaultBodyLimit::max(
             state.limits.max_body_bytes,
         ))

@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 mod cli_render;
 mod compare;
 mod hardcases;
+mod help;
 mod plot;
 mod serve;
 
@@ -42,6 +43,11 @@ enum Command {
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() -> ExitCode {
+    if let Some(dir) = continuum::mesa::private_runtime_dir() {
+        // SAFETY: the first statement of `main`, before any thread exists, so
+        // nothing reads the environment while it changes.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", dir) };
+    }
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Render(args)) => cli_render::run(&args),

@@ -1,6 +1,7 @@
 //! The render endpoints and the listings.
 
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use axum::Json;
 use axum::body::Bytes;
@@ -171,6 +172,10 @@ async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, 
         }
     };
     let job_state = state.clone();
+    // Set when the answer is 504: the render stops at its next tile and gives
+    // its slot back instead of finishing for nobody.
+    let cancel = Arc::new(AtomicBool::new(false));
+    let job_cancel = cancel.clone();
     let job = tokio::task::spawn_blocking(move || {
         let _permit = permit;
         let prepared = job_state.prepared(&c.scene)?;
@@ -188,21 +193,22 @@ async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, 
             precision: c.precision,
             texture_filter: c.texture_filter,
         };
-        let out = continuum::render(&prepared, &request)
+        let out = continuum::render_cancellable(&prepared, &request, &job_cancel)
             .map_err(|e| ApiError::bad_request(e.field, e.to_string()))?;
         job_state
             .metrics
             .observe_render(request.algorithm.as_str(), out.stats.time_ms.total / 1e3);
         Ok((out, prepared.scene.name.clone(), request.camera.name))
     });
-    // The job keeps its render slot until it ends, so a timed-out render still
-    // counts against the concurrency limit.
+    // The job keeps its render slot until it ends; a timed-out render is
+    // cancelled, so it ends within a tile's time.
     let result = tokio::time::timeout(timeout, job).await.map_err(|_| {
+        cancel.store(true, Ordering::Relaxed);
         ApiError::with_status(
             axum::http::StatusCode::GATEWAY_TIMEOUT,
-            None,
+            Some("timeout"),
             format!(
-                "the render did not finish within {} s",
+                "the render did not finish within {} s and was cancelled",
                 timeout.as_secs_f64()
             ),
         )
@@ -224,8 +230,10 @@ fn image(out: &RenderOutput, name: &str) -> Vec<u8> {
 /// `POST /api/render`.
 pub async fn render_json(
     State(state): State<Arc<AppState>>,
+    headers: axum::http::HeaderMap,
     body: Result<Bytes, axum::extract::rejection::BytesRejection>,
 ) -> Result<Json<Value>, ApiError> {
+    ApiError::require_json(&headers)?;
     let body = body.map_err(|e| ApiError::body(&e))?;
     let body: RenderBody = serde_json::from_slice(&body).map_err(|e| json_error(&e))?;
     let checked = check(&body, &state)?;
@@ -295,42 +303,16 @@ pub async fn render_png(
     Ok(([(header::CONTENT_TYPE, "image/png")], image(&out, &output)).into_response())
 }
 
-/// `GET /api/scenes`: names, triangle counts and cameras.
+/// `GET /api/scenes`: names, triangle counts, cameras, lights and effects of
+/// every scene, from the scene files (each loaded once, in parallel, never
+/// prepared: listing costs no BVH).
 pub async fn scenes(State(state): State<Arc<AppState>>) -> Result<Json<Value>, ApiError> {
     let list = tokio::task::spawn_blocking(move || {
-        state
-            .scene_names()
-            .into_iter()
-            .map(|name| match state.prepared(&name) {
-                Ok(p) => {
-                    let cameras: Vec<Value> = p
-                        .scene
-                        .all_cameras()
-                        .iter()
-                        .map(|c| {
-                            json!({
-                                "name": c.name, "eye": c.eye.to_array(), "target": c.target.to_array(),
-                                "up": c.up.to_array(), "viewport": c.viewport.to_string(),
-                                "fov_y": match c.viewport {
-                                    Viewport::Perspective { fov_y_deg } => Some(fov_y_deg),
-                                    _ => None,
-                                },
-                                "near": c.near,
-                            })
-                        })
-                        .collect();
-                    json!({
-                        "name": name,
-                        "triangles": p.triangle_count(),
-                        "cameras": cameras,
-                        "lights": p.scene.lights.len(),
-                        // What the scene calls for; shading runs Lambert only so far.
-                        "effects": p.scene.effects(),
-                        "warnings": p.scene.warnings,
-                    })
-                }
-                Err(e) => json!({ "name": name, "error": e.error }),
-            })
+        use rayon::prelude::*;
+        let names = state.scene_names();
+        names
+            .par_iter()
+            .map(|name| (*state.describe(name)).clone())
             .collect::<Vec<_>>()
     })
     .await
@@ -338,13 +320,54 @@ pub async fn scenes(State(state): State<Arc<AppState>>) -> Result<Json<Value>, A
     Ok(Json(json!({ "scenes": list })))
 }
 
-/// `GET /api/algorithms`.
-pub async fn algorithms() -> Json<Value> {
+/// A scene's catalogue entry.
+pub(crate) fn scene_entry(name: &str, scene: &continuum::Scene, triangles: usize) -> Value {
+    let cameras: Vec<Value> = scene
+        .all_cameras()
+        .iter()
+        .map(|c| {
+            json!({
+                "name": c.name, "eye": c.eye.to_array(), "target": c.target.to_array(),
+                "up": c.up.to_array(), "viewport": c.viewport.to_string(),
+                "fov_y": match c.viewport {
+                    Viewport::Perspective { fov_y_deg } => Some(fov_y_deg),
+                    _ => None,
+                },
+                "near": c.near,
+            })
+        })
+        .collect();
+    json!({
+        "name": name,
+        "triangles": triangles,
+        "cameras": cameras,
+        "lights": scene.lights.len(),
+        // What the scene calls for beyond Lambert shading.
+        "effects": scene.effects(),
+        "warnings": scene.warnings,
+    })
+}
+
+/// `GET /api/algorithms`: every algorithm, what it serves, and whether this
+/// server can run it (`available`, with `unavailable_reason` when not).
+pub async fn algorithms() -> Result<Json<Value>, ApiError> {
+    // Asking about the GPU opens it the first time: off the async runtime.
+    let unavailable: Vec<Option<String>> = tokio::task::spawn_blocking(|| {
+        AlgorithmId::ALL
+            .into_iter()
+            .map(continuum::unavailable)
+            .collect()
+    })
+    .await
+    .map_err(|e| ApiError::internal(e.to_string()))?;
     let list: Vec<Value> = AlgorithmId::ALL
         .iter()
-        .map(|a| {
+        .zip(unavailable)
+        .map(|(a, why)| {
             json!({
                 "id": a.as_str(),
+                "available": why.is_none(),
+                "unavailable_reason": why,
                 "family": a.family(),
                 "description": a.description(),
                 "viewports": Viewport::KINDS
@@ -366,7 +389,7 @@ pub async fn algorithms() -> Json<Value> {
             })
         })
         .collect();
-    Json(json!({ "algorithms": list }))
+    Ok(Json(json!({ "algorithms": list })))
 }
 
 /// A JSON body error → 400 naming the unknown or missing field, else `body`.

@@ -44,6 +44,17 @@ pub struct ServeArgs {
     /// Memory for prepared scenes in MiB [default: 2048].
     #[arg(long)]
     pub cache_mib: Option<usize>,
+    /// Log lines as plain text (colours only on a terminal) or as one JSON object each.
+    #[arg(long, value_enum, default_value_t = LogFormat::Text)]
+    pub log_format: LogFormat,
+}
+
+/// How `continuum serve` writes its log (standard error).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum LogFormat {
+    #[default]
+    Text,
+    Json,
 }
 
 impl ServeArgs {
@@ -97,11 +108,17 @@ impl ServeArgs {
 }
 
 pub fn run(args: &ServeArgs) -> Result<(), CliError> {
-    tracing_subscriber::fmt()
-        .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()),
-        )
-        .init();
+    use std::io::IsTerminal;
+    let filter =
+        tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into());
+    let log = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr);
+    match args.log_format {
+        LogFormat::Json => log.json().init(),
+        // Colour codes only where a terminal shows them, not in files or `docker logs`.
+        LogFormat::Text => log.with_ansi(std::io::stderr().is_terminal()).init(),
+    }
     let addr = args.addr.clone().unwrap_or_else(|| "127.0.0.1:8080".into());
     let dir = scenes_dir(args.scenes.as_ref());
     if !dir.is_dir() {
@@ -116,7 +133,14 @@ pub fn run(args: &ServeArgs) -> Result<(), CliError> {
         let listener = tokio::net::TcpListener::bind(&addr)
             .await
             .map_err(|e| CliError::Usage(format!("--addr: cannot listen on {addr}: {e}")))?;
-        tracing::info!(%addr, scenes = %dir.display(), ?limits, "continuum serving");
+        let url = match listener.local_addr() {
+            Ok(a) if a.ip().is_unspecified() => format!("http://localhost:{}/", a.port()),
+            Ok(a) => format!("http://{a}/"),
+            Err(_) => format!("http://{addr}/"),
+        };
+        tracing::info!(%addr, %url, scenes = %dir.display(), ?limits, "continuum serving");
+        // The one line a user needs, on standard output whatever the log says.
+        println!("continuum: open {url} (Ctrl-C stops)");
         let state = AppState::new(dir.clone(), limits);
         axum::serve(listener, app(state))
             .with_graceful_shutdown(shutdown_signal())

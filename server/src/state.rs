@@ -26,7 +26,7 @@ pub struct Limits {
     pub max_concurrent_renders: usize,
     /// Renders that may wait for a slot; more get 503 with `Retry-After`.
     pub max_queued_renders: usize,
-    /// A render not finished by then is answered with 504 (it still completes).
+    /// A render not finished by then is answered with 504 and cancelled.
     pub render_timeout: Duration,
     /// Largest request body (JSON requests and `.glb` uploads), bytes.
     pub max_body_bytes: usize,
@@ -116,6 +116,9 @@ pub struct AppState {
     /// Requests waiting for a render slot.
     pub(crate) queued: std::sync::atomic::AtomicUsize,
     cache: Mutex<Cache>,
+    /// What `GET /api/scenes` says of each scene (cameras, triangles, lights),
+    /// made from the loaded scene once, never by preparing it.
+    catalogue: Mutex<HashMap<String, Arc<serde_json::Value>>>,
 }
 
 /// A place in the render queue, given back when dropped.
@@ -137,6 +140,7 @@ impl AppState {
             metrics: crate::metrics::Metrics::default(),
             queued: std::sync::atomic::AtomicUsize::new(0),
             cache: Mutex::new(Cache::default()),
+            catalogue: Mutex::new(HashMap::new()),
         })
     }
 
@@ -211,9 +215,47 @@ impl AppState {
 
     /// Keeps an uploaded, prepared scene under `name`.
     pub fn add_upload(&self, name: &str, scene: Arc<PreparedScene>) -> Result<(), ApiError> {
+        self.remember(name, &scene.scene, scene.triangle_count());
         self.cache()?
             .insert(name, scene, true, self.limits.max_cache_bytes);
         Ok(())
+    }
+
+    /// The catalogue entry of `name`: from the cache of entries, else from the
+    /// prepared scene if one is cached, else by loading (not preparing) the
+    /// scene. Blocking: call off the async runtime.
+    pub fn describe(&self, name: &str) -> Arc<serde_json::Value> {
+        if let Some(entry) = self.catalogue.lock().ok().and_then(|c| c.get(name).cloned()) {
+            return entry;
+        }
+        if let Ok(Some(p)) = self.cache().map(|mut c| c.get(name)) {
+            return self.remember(name, &p.scene, p.triangle_count());
+        }
+        match continuum::scene::load_named_or_path(name, &self.scenes_dir) {
+            Ok(scene) => {
+                let triangles = scene.mesh.triangle_count();
+                self.remember(name, &scene, triangles)
+            }
+            Err(e) => Arc::new(serde_json::json!({
+                "name": name,
+                "error": format!("scene '{name}' failed to load: {e}"),
+            })),
+        }
+    }
+
+    /// Keeps `scene`'s catalogue entry under `name`.
+    fn remember(&self, name: &str, scene: &continuum::Scene, triangles: usize) -> Arc<serde_json::Value> {
+        let entry = Arc::new(crate::render_api::scene_entry(name, scene, triangles));
+        if let Ok(mut c) = self.catalogue.lock() {
+            c.insert(name.to_string(), entry.clone());
+        }
+        entry
+    }
+
+    /// Is any prepared scene cached? (Tests check that listing prepares none.)
+    #[doc(hidden)]
+    pub fn prepared_count(&self) -> usize {
+        self.cache_usage().0
     }
 
     /// The render-slot semaphore, so tests can hold slots as long renders would.

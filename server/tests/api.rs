@@ -52,6 +52,18 @@ fn http(
     content_type: &str,
     body: &[u8],
 ) -> (StatusCode, Vec<u8>) {
+    let (status, _, body) = http_with_headers(server, method, path, content_type, body);
+    (status, body)
+}
+
+/// [`http`], also returning the response's header lines (lower case).
+fn http_with_headers(
+    server: &Server,
+    method: &str,
+    path: &str,
+    content_type: &str,
+    body: &[u8],
+) -> (StatusCode, Vec<String>, Vec<u8>) {
     let mut stream = TcpStream::connect(server.addr).expect("connect");
     stream
         .set_read_timeout(Some(Duration::from_secs(120)))
@@ -99,7 +111,7 @@ fn http(
     } else {
         rest
     };
-    (StatusCode::from_u16(code).expect("status"), body)
+    (StatusCode::from_u16(code).expect("status"), headers, body)
 }
 
 fn dechunk(mut data: &[u8]) -> Vec<u8> {
@@ -530,4 +542,103 @@ fn slow_renders_time_out_with_504() {
         r#"{ "scene": "teapots", "algorithm": "2dr-brute", "size": "640x480" }"#,
     );
     assert_eq!(status, StatusCode::GATEWAY_TIMEOUT, "{doc}");
+}
+
+#[test]
+fn a_render_answered_504_is_cancelled_and_frees_its_slot() {
+    // One slot; a following request waits at most the timeout for it.
+    let s = state(Limits {
+        max_concurrent_renders: 1,
+        max_queued_renders: 1,
+        render_timeout: Duration::from_secs(1),
+        ..Limits::default()
+    });
+    for scene in ["teapots", "box"] {
+        s.state.prepared(scene).expect("prepared ahead, outside the timeout");
+    }
+    // Seconds of work: a million triangles at 2560x1600 with 16 samples per pixel.
+    let (status, doc) = post(
+        &s,
+        "/api/render",
+        r#"{ "scene": "teapots", "algorithm": "3dr-brute", "size": "2560x1600", "aa": "ssaa:16" }"#,
+    );
+    assert_eq!(status, StatusCode::GATEWAY_TIMEOUT, "{doc}");
+    assert_eq!(doc["field"], "timeout", "{doc}");
+    // The cancelled render gives its slot back within a tile's time: this
+    // request gets it within its one-second wait (else 503) and renders.
+    let (status, doc) = post(
+        &s,
+        "/api/render",
+        r#"{ "scene": "box", "algorithm": "raycast", "size": "16x16" }"#,
+    );
+    assert_eq!(status, StatusCode::OK, "{doc}");
+}
+
+#[test]
+fn every_error_status_answers_error_and_field_as_json() {
+    let s = state(Limits {
+        max_body_bytes: 1 << 10,
+        render_timeout: Duration::from_nanos(1),
+        ..Limits::default()
+    });
+    let big = vec![b'x'; 4 << 10];
+    let render = br#"{ "scene": "box", "algorithm": "raycast", "size": "16x16" }"#;
+    let cases: [(&str, &str, &str, &[u8], StatusCode, &str); 7] = [
+        ("GET", "/api/render.png?scene=nosuch&algorithm=raycast", "", b"", StatusCode::BAD_REQUEST, "scene"),
+        ("GET", "/no/such/route", "", b"", StatusCode::NOT_FOUND, "path"),
+        ("GET", "/api/render", "", b"", StatusCode::METHOD_NOT_ALLOWED, "method"),
+        ("POST", "/api/render", "application/json", &big, StatusCode::PAYLOAD_TOO_LARGE, "body"),
+        ("POST", "/api/render", "text/plain", render, StatusCode::UNSUPPORTED_MEDIA_TYPE, "content-type"),
+        ("POST", "/api/render", "", b"", StatusCode::UNSUPPORTED_MEDIA_TYPE, "content-type"),
+        ("POST", "/api/render", "application/json; charset=utf-8", render, StatusCode::GATEWAY_TIMEOUT, "timeout"),
+    ];
+    for (method, path, kind, body, expected, field) in cases {
+        let (status, headers, bytes) = http_with_headers(&s, method, path, kind, body);
+        let text = String::from_utf8_lossy(&bytes);
+        assert_eq!(status, expected, "{method} {path}: {text}");
+        assert!(
+            headers.iter().any(|h| h.starts_with("content-type: application/json")),
+            "{method} {path}: {headers:?}"
+        );
+        let doc: serde_json::Value = serde_json::from_slice(&bytes).expect("a JSON body");
+        assert_eq!(doc["field"], field, "{method} {path}: {doc}");
+        assert!(doc["error"].as_str().is_some_and(|e| !e.is_empty()), "{doc}");
+    }
+}
+
+#[test]
+fn listing_scenes_prepares_none() {
+    let s = state(Limits::default());
+    let (status, body) = get(&s, "/api/scenes");
+    assert_eq!(status, StatusCode::OK);
+    let doc: serde_json::Value = serde_json::from_slice(&body).expect("json");
+    let listed = doc["scenes"].as_array().expect("list");
+    let builtin = continuum::scene::builtin_names(&s.state.scenes_dir);
+    assert!(builtin.len() >= 12, "{builtin:?}");
+    assert_eq!(listed.len(), builtin.len());
+    for scene in listed {
+        assert!(scene["error"].is_null(), "{scene}");
+        assert!(scene["triangles"].as_u64().is_some_and(|t| t > 0), "{scene}");
+        assert!(!scene["cameras"].as_array().expect("cameras").is_empty(), "{scene}");
+    }
+    let teapots = listed.iter().find(|s| s["name"] == "teapots").expect("teapots");
+    assert_eq!(teapots["triangles"], 1_048_576);
+    assert_eq!(s.state.prepared_count(), 0, "listing prepared a scene");
+}
+
+#[test]
+fn algorithms_say_whether_this_server_runs_them() {
+    let s = state(Limits::default());
+    let (status, body) = get(&s, "/api/algorithms");
+    assert_eq!(status, StatusCode::OK);
+    let doc: serde_json::Value = serde_json::from_slice(&body).expect("json");
+    let list = doc["algorithms"].as_array().expect("list");
+    assert_eq!(list.len(), continuum::AlgorithmId::ALL.len());
+    for a in list {
+        let id = a["id"].as_str().expect("id");
+        let available = a["available"].as_bool().expect("available");
+        let algorithm: continuum::AlgorithmId = id.parse().expect("an id");
+        assert_eq!(available, continuum::unavailable(algorithm).is_none(), "{a}");
+        assert_eq!(a["unavailable_reason"].is_null(), available, "{a}");
+    }
 }

@@ -141,7 +141,27 @@ fn the_page_renders_switches_maps_and_compares() {
         assert!(stats.contains("transparency") && stats.contains("shadows"), "{stats}");
         std::fs::write(shots.join("browser-pane.png"), client.screenshot().await.expect("screenshot")).expect("save");
 
-        // 4. The compare view: two images, their difference, the timing bars.
+        // 4. Downloads and "copy as curl" for the last render.
+        let downloads = text_of("downloads").await;
+        assert!(downloads.contains("color.png") && downloads.contains("statistics.json"), "{downloads}");
+        client.find(Locator::Id("copy-curl")).await.expect("copy as curl").click().await.expect("click");
+        let curl = wait_until("copy as curl", "curl", "curl -X POST").await;
+        assert!(curl.contains("/api/render") && curl.contains("\"scene\":\"pane\""), "{curl}");
+
+        // 5. Upload a .glb through the page and render it.
+        let glb = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes/assets/Box.glb");
+        let glb = glb.canonicalize().expect("Box.glb");
+        client.find(Locator::Id("upload-name")).await.expect("name").send_keys("my-box").await.expect("type");
+        client.find(Locator::Id("upload-file")).await.expect("file input")
+            .send_keys(glb.to_str().expect("utf-8 path")).await.expect("choose the file");
+        client.find(Locator::Id("upload")).await.expect("upload").click().await.expect("click");
+        wait_until("upload", "upload-status", "my-box: 12 triangles").await;
+        let scene = client.find(Locator::Id("scene")).await.expect("scene").prop("value").await.expect("value");
+        assert_eq!(scene.as_deref(), Some("my-box"));
+        wait_until("the uploaded scene's render", "stats", "total ms").await;
+        wait_until("the uploaded scene's downloads", "downloads", "my-box-").await;
+
+        // 6. The compare view: two images, their difference, the timing bars.
         client.find(Locator::Id("show-compare")).await.expect("compare").click().await.expect("click");
         let caption = wait_until("compare", "cap-diff", "pixels differ").await;
         assert!(caption.contains("difference"), "{caption}");

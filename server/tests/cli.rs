@@ -755,3 +755,189 @@ fn a_bad_sweep_file_is_an_error_naming_the_key() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--shard"));
     std::fs::remove_dir_all(&base).ok();
 }
+
+/// No Vulkan driver for the process: the loader finds no ICD.
+const WITHOUT_VULKAN: [(&str, &str); 2] = [
+    ("VK_ICD_FILENAMES", "/nonexistent/icd.json"),
+    ("VK_DRIVER_FILES", "/nonexistent/icd.json"),
+];
+
+fn no_panic(out: &Output) -> String {
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(!stderr.contains("panicked"), "a panic: {stderr}");
+    stderr
+}
+
+#[test]
+fn the_gl_backend_forced_is_a_named_error_not_a_panic() {
+    // wgpu's OpenGL backend (switched on in workspace builds by the viewer's
+    // test renderer) cannot render gpu-raster's formats on Mesa: refused by name.
+    for env in [&[("WGPU_BACKEND", "gl")][..], &WITHOUT_VULKAN[..]] {
+        let out = continuum_with(
+            &["render", "--scene", "box", "--algorithm", "gpu-raster", "--size", "16x16"],
+            env,
+        );
+        let stderr = no_panic(&out);
+        assert_eq!(out.status.code(), Some(2), "{env:?}: {stderr}");
+        assert!(stderr.contains("--algorithm") && stderr.contains("no Vulkan device"), "{env:?}: {stderr}");
+    }
+}
+
+#[test]
+fn compare_without_vulkan_leaves_gpu_raster_out_unless_named() {
+    let dir = out_dir("no-vulkan");
+    let args = ["compare", "--scenes", "box", "--size", "16x16", "--repeat", "1", "--out"];
+    let out = continuum_with(&[&args[..], &[dir.to_str().expect("utf-8")]].concat(), &WITHOUT_VULKAN);
+    let stderr = no_panic(&out);
+    assert!(out.status.success(), "{stderr}");
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("not run: gpu-raster"), "{table}");
+    let doc = results_json(&dir);
+    assert_eq!(doc["not_run"][0]["algorithm"], "gpu-raster", "{}", doc["not_run"]);
+    let rows = doc["rows"].as_array().expect("rows");
+    assert!(rows.iter().all(|r| r["algorithm"] != "gpu-raster"));
+    assert_eq!(
+        rows.iter().filter(|r| !r["algorithm"].as_str().is_some_and(|a| a.starts_with("peer-"))).count(),
+        continuum::AlgorithmId::ALL.len() - 1
+    );
+    let report = std::fs::read_to_string(dir.join("report.html")).expect("report");
+    assert!(report.contains("Not run on this machine") && report.contains("gpu-raster"));
+    std::fs::remove_dir_all(&dir).ok();
+    // Named, it fails before writing anything.
+    let named = out_dir("no-vulkan-named").join("results");
+    let out = continuum_with(
+        &[&args[..], &[named.to_str().expect("utf-8"), "--algorithms", "gpu-raster"]].concat(),
+        &WITHOUT_VULKAN,
+    );
+    let stderr = no_panic(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("gpu-raster") && stderr.contains("cannot run"), "{stderr}");
+    assert!(!named.exists(), "a failed compare left {}", named.display());
+    // hardcases likewise, and says so.
+    let cases = hard_cases();
+    let out = continuum_with(
+        &["hardcases", "--cases", cases.to_str().expect("utf-8"), "--only", "fans"],
+        &WITHOUT_VULKAN,
+    );
+    let stderr = no_panic(&out);
+    assert!(out.status.success(), "{stderr}");
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("not run on this machine: gpu-raster"), "{table}");
+}
+
+/// The `continuum` command lines of README.md's code blocks (continuation
+/// lines joined), as words.
+fn readme_commands() -> Vec<Vec<String>> {
+    let readme = std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../README.md"))
+        .expect("README.md");
+    let mut commands = Vec::new();
+    let mut in_code = false;
+    let mut joined = String::new();
+    for line in readme.lines() {
+        if line.trim_start().starts_with("```") {
+            in_code = !in_code;
+            continue;
+        }
+        if !in_code {
+            continue;
+        }
+        let line = line.split(" #").next().unwrap_or("").trim_end();
+        joined.push_str(line.trim_end_matches('\\'));
+        joined.push(' ');
+        if line.ends_with('\\') {
+            continue;
+        }
+        let words = shell_words(&joined);
+        joined.clear();
+        let start = if words.starts_with(&["cargo".into(), "run".into(), "--release".into(), "--".into()]) {
+            4
+        } else if words.first().is_some_and(|w| w == "continuum") {
+            1
+        } else {
+            continue;
+        };
+        commands.push(words[start..].to_vec());
+    }
+    commands
+}
+
+/// Splits a command line into words: whitespace outside quotes separates.
+fn shell_words(line: &str) -> Vec<String> {
+    let mut words = Vec::new();
+    let mut word = String::new();
+    let mut quote = None;
+    let mut any = false;
+    for c in line.chars() {
+        match (quote, c) {
+            (None, '\'' | '"') => {
+                quote = Some(c);
+                any = true;
+            }
+            (Some(q), c) if c == q => quote = None,
+            (None, c) if c.is_whitespace() => {
+                if any {
+                    words.push(std::mem::take(&mut word));
+                    any = false;
+                }
+            }
+            (_, c) => {
+                word.push(c);
+                any = true;
+            }
+        }
+    }
+    if any {
+        words.push(word);
+    }
+    words
+}
+
+#[test]
+fn the_readme_command_lines_use_flags_the_cli_has() {
+    let commands = readme_commands();
+    assert!(commands.len() >= 8, "found only {} command lines in README.md", commands.len());
+    let mut checked = 0;
+    for words in &commands {
+        // The subcommand path (`compare merge`), then its flags.
+        let path: Vec<&str> = words
+            .iter()
+            .map(String::as_str)
+            .take_while(|w| !w.starts_with('-'))
+            .filter(|w| ["serve", "render", "compare", "merge", "hardcases"].contains(w))
+            .collect();
+        let out = continuum(&[&path[..], &["--help"]].concat());
+        assert!(out.status.success(), "{path:?} --help");
+        let help = String::from_utf8_lossy(&out.stdout);
+        for flag in words.iter().filter(|w| w.starts_with("--")) {
+            let flag = flag.split('=').next().unwrap_or(flag);
+            assert!(
+                help.contains(&format!("{flag} ")) || help.contains(&format!("{flag}\n")),
+                "README: `continuum {}` uses {flag}, which `{} --help` does not list",
+                words.join(" "),
+                path.join(" ")
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 20, "only {checked} flags checked");
+}
+
+#[test]
+fn help_lists_every_value_and_marks_required_flags() {
+    let out = continuum(&["render", "--help"]);
+    let help = String::from_utf8_lossy(&out.stdout);
+    for a in continuum::AlgorithmId::ALL {
+        assert!(help.contains(a.as_str()), "render --help omits {a}: {help}");
+    }
+    for m in continuum::AaMode::all() {
+        assert!(help.contains(&m.to_string()), "render --help omits aa {m}");
+    }
+    assert!(help.contains("--scene <SCENE>") && !help.contains("[SCENE]"), "{help}");
+    let out = continuum(&["compare", "--help"]);
+    let help = String::from_utf8_lossy(&out.stdout);
+    assert!(help.contains("--out <OUT>"), "{help}");
+    assert!(help.contains("gpu-raster") && help.contains("peer-obvhs"), "{help}");
+    // Required: the usage line names it outside brackets.
+    let usage = help.lines().find(|l| l.starts_with("Usage:")).expect("usage line");
+    assert!(usage.contains("--out <OUT>") && !usage.contains("[--out"), "{usage}");
+}

@@ -678,8 +678,14 @@ fn method_controls(ui: &mut egui::Ui, id: &str, method: &mut Method) {
                 .selected_text(method.algorithm.as_str())
                 .show_ui(ui, |ui| {
                     for a in AlgorithmId::ALL {
-                        ui.selectable_value(&mut method.algorithm, a, a.as_str())
-                            .on_hover_text(a.description());
+                        // What this machine cannot run stays listed, greyed out, with why.
+                        let why = continuum::unavailable(a);
+                        ui.add_enabled_ui(why.is_none(), |ui| {
+                            ui.selectable_value(&mut method.algorithm, a, a.as_str())
+                        })
+                        .inner
+                        .on_hover_text(a.description())
+                        .on_disabled_hover_text(why.unwrap_or_default());
                     }
                 })
                 .response

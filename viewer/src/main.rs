@@ -25,8 +25,7 @@ struct Args {
     /// A camera of the scene (by name); default: the scene's first camera.
     #[arg(long)]
     camera: Option<String>,
-    /// Algorithm id (see `continuum render --help`).
-    #[arg(long, default_value = "3dr-brute")]
+    #[arg(long, default_value = "3dr-brute", help = format!("Algorithm id: {}", continuum::AlgorithmId::ALL.map(|a| a.as_str()).join(", ")))]
     algorithm: String,
     /// Explicit oracle settings on top of the algorithm's, e.g. outside=on,split=8.
     #[arg(long)]
@@ -34,8 +33,7 @@ struct Args {
     /// Viewport: `perspective[:FOV]`, `orthographic[:HEIGHT]`, `parabolic` or `latlong`.
     #[arg(long)]
     viewport: Option<String>,
-    /// Anti-aliasing mode: none, ssaa:N, msaa:N, csaa:CxS.
-    #[arg(long, default_value = "none")]
+    #[arg(long, default_value = "none", help = format!("Anti-aliasing mode: {}", continuum::AaMode::all().iter().map(ToString::to_string).collect::<Vec<_>>().join(", ")))]
     aa: String,
     /// Precision of coverage decisions: f32, f64 or fixed.
     #[arg(long, default_value = "f32")]
@@ -68,6 +66,11 @@ struct Args {
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() -> ExitCode {
+    if let Some(dir) = continuum::mesa::private_runtime_dir() {
+        // SAFETY: the first statement of `main`, before any thread exists, so
+        // nothing reads the environment while it changes.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", dir) };
+    }
     let args = Args::parse();
     let usage = |message: String| {
         eprintln!("error: {message}");

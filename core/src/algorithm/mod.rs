@@ -484,6 +484,9 @@ pub(crate) struct TileContext<'a> {
     pub shader: Shader<'a>,
     /// Opacity per triangle id (empty: every triangle opaque).
     pub opacity: &'a [f32],
+    /// Set by the caller to abandon the render: tiles not yet started are
+    /// left empty (checked once per tile or band).
+    pub cancel: &'a std::sync::atomic::AtomicBool,
 }
 
 /// A tile rendered and resolved by one worker, with what its rendering returned.
@@ -491,6 +494,8 @@ pub(crate) struct TileContext<'a> {
 pub(crate) struct Finished<R> {
     pub resolved: ResolvedTile,
     pub result: R,
+    /// Edge tests decided past f32 while rendering, `[f64 + exact, exact]`.
+    pub precise: [u64; 2],
     /// Worker seconds spent rendering and resolving.
     pub render_s: f64,
     pub resolve_s: f64,
@@ -501,6 +506,7 @@ impl<R> Finished<R> {
         Finished {
             resolved: self.resolved,
             result: f(self.result),
+            precise: self.precise,
             render_s: self.render_s,
             resolve_s: self.resolve_s,
         }
@@ -512,7 +518,7 @@ impl<'a> TileContext<'a> {
     /// then resolves their samples. The sample buffers are `cache`'s, reused
     /// from the worker's previous tile when there is one (no fresh pages to
     /// fault in per tile).
-    pub fn run_tile<R>(
+    pub fn run_tile<R: Default>(
         &self,
         cache: &mut Option<TileBuffer<'a>>,
         (x0, y0, x1, y1): (u32, u32, u32, u32),
@@ -530,13 +536,17 @@ impl<'a> TileContext<'a> {
                 self.opacity,
             )),
         };
-        let result = render(tile);
+        let cancelled = self.cancel.load(std::sync::atomic::Ordering::Relaxed);
+        let precise = crate::edge::precise_tests();
+        let result = if cancelled { R::default() } else { render(tile) };
+        let precise_after = crate::edge::precise_tests();
         let render_s = start.elapsed().as_secs_f64();
         let start = Instant::now();
         let resolved = resolve_tile(tile, self.view, &self.shader);
         Finished {
             resolved,
             result,
+            precise: [0, 1].map(|k| precise_after[k] - precise[k]),
             render_s,
             resolve_s: start.elapsed().as_secs_f64(),
         }
@@ -565,6 +575,8 @@ impl Pass {
             .into_iter()
             .map(|finished| {
                 self.counters += finished.result;
+                self.counters.edge_tests_f64 += finished.precise[0];
+                self.counters.edge_tests_exact += finished.precise[1];
                 self.histogram += finished.resolved.histogram;
                 self.shading_samples += finished.resolved.shading_samples;
                 self.effects.add(&finished.resolved.effects);

@@ -513,11 +513,10 @@ impl ExactEdges<'_> {
     #[cold]
     fn inside(&self, i: usize, x: f32, y: f32) -> bool {
         let (v, bound) = self.value_f64(i, x, y);
-        if v > bound {
-            return true;
-        }
-        if v < -bound {
-            return false;
+        let certain = v.abs() > bound;
+        super::count_precise(!certain);
+        if certain {
+            return v > 0.0;
         }
         let (value, _) = self.value(i, x, y, false);
         match value.signum() {

@@ -28,6 +28,28 @@ pub(crate) use edge3d::EPS;
 pub use edge3d::Triangle3D;
 pub use edge3d_f64::Triangle3D64;
 pub use homogeneous::setup_homogeneous;
+
+thread_local! {
+    /// This thread's running count of 3D edge tests the f32 sign could not
+    /// decide: `[evaluated in f64, of those decided exactly]`.
+    static PRECISE_TESTS: std::cell::Cell<[u64; 2]> = const { std::cell::Cell::new([0, 0]) };
+}
+
+/// Counts one edge test decided past f32 (on the cold path only).
+fn count_precise(exactly: bool) {
+    PRECISE_TESTS.with(|c| {
+        let mut n = c.get();
+        n[0] += 1;
+        n[1] += u64::from(exactly);
+        c.set(n);
+    });
+}
+
+/// This thread's running count of edge tests decided past f32, `[in f64,
+/// of those exactly]`: a tile's share is the difference across its rendering.
+pub(crate) fn precise_tests() -> [u64; 2] {
+    PRECISE_TESTS.with(std::cell::Cell::get)
+}
 pub(crate) use homogeneous::{HomogeneousVertex, setup_homogeneous_from};
 
 /// Up to eight triangles to set up together, one per lane: their corners,

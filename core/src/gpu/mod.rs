@@ -15,7 +15,7 @@
 //! them (lavapipe: vertices snapped to 1/256 pixel, top-left rule); the
 //! conformance tests compare it with `--precision fixed`.
 
-use std::sync::{Mutex, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 use crate::aa::resolve::resolve_tile;
@@ -70,6 +70,10 @@ pub fn gpu() -> Result<&'static Gpu, GpuError> {
     GPU.get_or_init(Gpu::open).as_ref().map_err(Clone::clone)
 }
 
+/// A device error raised outside an error scope, kept for the next draw to
+/// report instead of wgpu's default handler, which panics.
+static UNCAPTURED: Mutex<Option<String>> = Mutex::new(None);
+
 const ID_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 const W_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
@@ -100,14 +104,19 @@ impl CameraUniform {
 
 impl Gpu {
     fn open() -> Result<Gpu, GpuError> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        // 1. An adapter: Vulkan (or another primary backend; `WGPU_BACKEND`
+        //    overrides), never a backend that may lack the formats we render to
+        //    unless asked for by name, and then checked before use.
+        let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
+        descriptor.backends = wgpu::Backends::PRIMARY;
+        let instance = wgpu::Instance::new(descriptor.with_env());
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             ..Default::default()
         }))
         .map_err(|e| GpuError::NoDevice(e.to_string()))?;
         let info = adapter.get_info();
+        let adapter_name = format!("{} ({}, {:?})", info.name, info.driver, info.backend);
         let depth_format = if adapter
             .features()
             .contains(wgpu::Features::DEPTH32FLOAT_STENCIL8)
@@ -116,6 +125,14 @@ impl Gpu {
         } else {
             wgpu::TextureFormat::Depth24PlusStencil8
         };
+        for format in [ID_FORMAT, W_FORMAT, depth_format] {
+            let usages = adapter.get_texture_format_features(format).allowed_usages;
+            if !usages.contains(wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC) {
+                return Err(GpuError::NoDevice(format!(
+                    "the adapter {adapter_name} cannot render to {format:?}"
+                )));
+            }
+        }
         let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("continuum"),
@@ -128,6 +145,13 @@ impl Gpu {
             ..Default::default()
         }))
         .map_err(|e| GpuError::NoDevice(e.to_string()))?;
+        // 2. The pipeline, its validation errors caught (a driver that refuses
+        //    it is "no device", not a panic); later errors outside a scope are
+        //    kept for the draw to report.
+        device.on_uncaptured_error(Arc::new(|e: wgpu::Error| {
+            *UNCAPTURED.lock().unwrap_or_else(|p| p.into_inner()) = Some(e.to_string());
+        }));
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("raster.wgsl"),
             source: wgpu::ShaderSource::Wgsl(include_str!("raster.wgsl").into()),
@@ -212,13 +236,18 @@ impl Gpu {
             multiview_mask: None,
             cache: None,
         });
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(GpuError::NoDevice(format!(
+                "the adapter {adapter_name} refused the pipeline: {e}"
+            )));
+        }
         Ok(Gpu {
             device,
             queue,
             pipeline,
             layout,
             depth_format,
-            adapter: format!("{} ({}, {:?})", info.name, info.driver, info.backend),
+            adapter: adapter_name,
             max_dimension: limits.max_texture_dimension_2d,
             lock: Mutex::new(()),
         })
@@ -269,6 +298,7 @@ impl Gpu {
         }
         let _one_at_a_time = self.lock.lock().unwrap_or_else(|e| e.into_inner());
         let device = &self.device;
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         // 1. Targets and the camera.
         let size = wgpu::Extent3d {
             width,
@@ -391,6 +421,12 @@ impl Gpu {
         let w_buffer = readback(&ws, wgpu::TextureAspect::All, 4, &mut encoder);
         let count_buffer = readback(&depth, wgpu::TextureAspect::StencilOnly, 1, &mut encoder);
         self.queue.submit([encoder.finish()]);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(GpuError::Failed(e.to_string()));
+        }
+        if let Some(e) = UNCAPTURED.lock().unwrap_or_else(|p| p.into_inner()).take() {
+            return Err(GpuError::Failed(e));
+        }
         for (b, _) in [&id_buffer, &w_buffer, &count_buffer] {
             b.map_async(wgpu::MapMode::Read, .., |_| {});
         }
@@ -507,3 +543,4 @@ fn orthographic_far(scene: &PreparedScene, view: &View) -> f32 {
     }
     far
 }
+

@@ -310,12 +310,22 @@ pub struct Check {
     pub limit: Option<String>,
 }
 
-/// Every (algorithm, precision) that serves `viewport`: every algorithm at
-/// f32, the 3D family also at f64, the 2D family also in fixed point.
+/// Every (algorithm, precision) that serves `viewport` and that this machine
+/// can run (see [`crate::unavailable`]; the suite reports the others as not
+/// run): every algorithm at f32, the 3D family also at f64, the 2D family also
+/// in fixed point.
 pub fn variants(viewport: &Viewport) -> Vec<(AlgorithmId, Precision)> {
     variants_of_all()
         .into_iter()
-        .filter(|&(a, _)| viewport.serves(a))
+        .filter(|&(a, _)| viewport.serves(a) && crate::unavailable(a).is_none())
+        .collect()
+}
+
+/// The algorithms this machine cannot run, with why.
+pub fn not_run() -> Vec<(AlgorithmId, String)> {
+    AlgorithmId::ALL
+        .into_iter()
+        .filter_map(|a| Some((a, crate::unavailable(a)?)))
         .collect()
 }
 
@@ -585,6 +595,8 @@ pub struct CaseSummary {
 pub struct SuiteReport {
     pub cases: Vec<CaseSummary>,
     pub checks: Vec<Check>,
+    /// Algorithms left out because this machine cannot run them, with why.
+    pub not_run: Vec<(AlgorithmId, String)>,
 }
 
 /// Runs every case.
@@ -614,5 +626,6 @@ pub fn run_suite(cases: &[HardCase]) -> Result<SuiteReport, SceneError> {
     Ok(SuiteReport {
         cases: summaries,
         checks: all,
+        not_run: not_run(),
     })
 }

@@ -41,18 +41,19 @@ fn load(bytes: &[u8], file: &str, name: String, base: Option<&Path>) -> Result<S
         path: file.to_string(),
         message: e.to_string(),
     };
-    // The gltf crate validates and reads accessors with unchecked indexing on
-    // some malformed inputs (found by fuzzing: `fuzz/`); a panic there must
-    // become an error, not take the caller down.
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        let gltf = gltf::Gltf::from_slice(bytes).map_err(gltf_err)?;
-        read_document(&gltf, file, name, base)
-    }))
-    .unwrap_or_else(|_| {
-        Err(SceneError::Gltf {
-            path: file.to_string(),
-            message: "malformed accessor or buffer data".into(),
-        })
+    let gltf = guarded(file, || gltf::Gltf::from_slice(bytes))?.map_err(gltf_err)?;
+    read_document(&gltf, file, name, base)
+}
+
+/// Runs one call into the gltf crate, which validates and reads accessors
+/// with unchecked indexing on some malformed inputs (found by fuzzing:
+/// `fuzz/`): its panic becomes an error naming `location`. Only the
+/// third-party call is guarded, so a panic of continuum's own code still
+/// surfaces (and fails the loaders' property test).
+fn guarded<T>(location: &str, call: impl FnOnce() -> T) -> Result<T, SceneError> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(call)).map_err(|_| SceneError::Gltf {
+        path: location.to_string(),
+        message: "malformed accessor or buffer data".into(),
     })
 }
 
@@ -79,8 +80,10 @@ fn read_document(
             ),
         });
     }
-    let buffers =
-        gltf::import_buffers(&gltf.document, base, gltf.blob.clone()).map_err(gltf_err)?;
+    let buffers = guarded(file, || {
+        gltf::import_buffers(&gltf.document, base, gltf.blob.clone())
+    })?
+    .map_err(gltf_err)?;
     let doc = &gltf.document;
 
     let mut scene = Scene {
@@ -275,43 +278,42 @@ fn read_primitive(
             location: location.to_string(),
         });
     }
-    let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-    let positions: Vec<Vec3> = reader
-        .read_positions()
-        .ok_or_else(|| SceneError::Invalid {
-            location: location.to_string(),
-            problem: "has no POSITION attribute".into(),
-        })?
-        .map(Vec3::from)
-        .collect();
-    let normals: Vec<Vec3> = reader
-        .read_normals()
-        .map(|n| n.map(Vec3::from).collect())
-        .unwrap_or_default();
     // The texture coordinate set the material's base-colour texture names.
     let uv_set = prim
         .material()
         .pbr_metallic_roughness()
         .base_color_texture()
         .map_or(0, |info| info.tex_coord());
-    let uvs: Vec<Vec2> = reader
-        .read_tex_coords(uv_set)
-        .map(|t| t.into_f32().map(Vec2::from).collect())
-        .unwrap_or_default();
-    let colors: Vec<Vec4> = reader
-        .read_colors(0)
-        .map(|c| c.into_rgba_f32().map(Vec4::from).collect())
-        .unwrap_or_default();
+    let (positions, normals, uvs, colors, indices) = guarded(&location.to_string(), || {
+        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+        let positions: Option<Vec<Vec3>> =
+            reader.read_positions().map(|p| p.map(Vec3::from).collect());
+        let normals: Vec<Vec3> = reader
+            .read_normals()
+            .map(|n| n.map(Vec3::from).collect())
+            .unwrap_or_default();
+        let uvs: Vec<Vec2> = reader
+            .read_tex_coords(uv_set)
+            .map(|t| t.into_f32().map(Vec2::from).collect())
+            .unwrap_or_default();
+        let colors: Vec<Vec4> = reader
+            .read_colors(0)
+            .map(|c| c.into_rgba_f32().map(Vec4::from).collect())
+            .unwrap_or_default();
+        let indices: Option<Vec<u32>> = reader.read_indices().map(|i| i.into_u32().collect());
+        (positions, normals, uvs, colors, indices)
+    })?;
+    let positions = positions.ok_or_else(|| SceneError::Invalid {
+        location: location.to_string(),
+        problem: "has no POSITION attribute".into(),
+    })?;
     if let Some(v) = colors.iter().position(|c| !c.is_finite()) {
         return Err(SceneError::Invalid {
             location: location.to_string(),
             problem: format!("COLOR_0 of vertex {v} is not finite"),
         });
     }
-    let indices: Vec<u32> = match reader.read_indices() {
-        Some(i) => i.into_u32().collect(),
-        None => (0..positions.len() as u32).collect(),
-    };
+    let indices = indices.unwrap_or_else(|| (0..positions.len() as u32).collect());
     let triangles = assemble_triangles(prim.mode(), &indices, location)?;
     validate_part(&positions, &triangles, location)?;
     let normals = if normals.len() == positions.len() {

@@ -27,7 +27,7 @@ use measure::{LoadedScene, measure_cell};
 use sweep::{Shard, Sweep, SweepFile, read_sweep_file};
 
 #[derive(Args, Debug)]
-#[command(args_conflicts_with_subcommands = true)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct CompareArgs {
     #[command(subcommand)]
     command: Option<CompareCommand>,
@@ -41,9 +41,7 @@ pub struct CompareArgs {
     /// Scenes: built-in names or paths, comma-separated [default: every built-in scene].
     #[arg(long, value_delimiter = ',')]
     scenes: Vec<String>,
-    /// Algorithm ids and peers (peer-obvhs; peer-embree and peer-embree-stream with
-    /// the `embree` feature), comma-separated [default: all that are built in].
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_delimiter = ',', help = crate::help::algorithms_and_peers())]
     algorithms: Vec<String>,
     /// Camera name; default: each scene's first camera.
     #[arg(long)]
@@ -61,7 +59,8 @@ pub struct CompareArgs {
     /// Worker threads [default: all cores].
     #[arg(long)]
     threads: Option<u32>,
-    /// Anti-aliasing modes, comma-separated (none, ssaa:N, msaa:N, csaa:CxS);
+    /// Anti-aliasing modes, comma-separated (none, ssaa:4|16|64|256,
+    /// msaa:2|4|8|16, csaa:CxS with C in 4, 8, 16 and S in 1, 2, 4, 8 below C);
     /// each is measured against a ssaa:256 reference and plotted in aa_cost.svg
     /// [default: none, without a reference].
     #[arg(long, value_delimiter = ',')]
@@ -71,8 +70,8 @@ pub struct CompareArgs {
     /// report their time against f32 [default: f32].
     #[arg(long, value_delimiter = ',')]
     precision: Vec<String>,
-    /// Folder for results.json, results.csv and report.html.
-    #[arg(long)]
+    /// Folder for results.json, results.csv and report.html (required).
+    #[arg(long, required = true)]
     out: Option<PathBuf>,
     /// Also print results.json on stdout.
     #[arg(long)]
@@ -281,12 +280,17 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         "command": std::env::args().collect::<Vec<_>>().join(" "),
         "sweep": sweep.file,
         "shard": args.shard,
+        "not_run": sweep.not_run,
     });
     let text = write_outputs(&out, meta, &rows, &out)?;
     if args.json {
         write_stdout(&(text + "\n"))?;
     } else {
-        write_stdout(&table_text(&rows))?;
+        let mut text = table_text(&rows);
+        for n in &sweep.not_run {
+            text.push_str(&format!("not run: {} ({})\n", n.algorithm, n.reason));
+        }
+        write_stdout(&text)?;
     }
     Ok(())
 }
@@ -392,6 +396,7 @@ fn merge(args: &MergeArgs) -> Result<(), CliError> {
     let mut shards = Vec::new();
     let mut sweep: Option<Value> = None;
     let mut seen: Vec<Value> = Vec::new();
+    let mut not_run: Vec<Value> = Vec::new();
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     for dir in &args.shards {
@@ -435,6 +440,11 @@ fn merge(args: &MergeArgs) -> Result<(), CliError> {
             }
         }
         rows.extend(part);
+        for n in doc["not_run"].as_array().into_iter().flatten() {
+            if !not_run.contains(n) {
+                not_run.push(n.clone());
+            }
+        }
         shards.push(json!({ "dir": dir.display().to_string(), "machine": doc["machine"], "command": doc["command"], "shard": shard }));
     }
     // Every part of the sweep must be there.
@@ -455,6 +465,7 @@ fn merge(args: &MergeArgs) -> Result<(), CliError> {
         "command": std::env::args().collect::<Vec<_>>().join(" "),
         "sweep": sweep.unwrap_or(Value::Null),
         "shards": shards,
+        "not_run": not_run,
     });
     write_outputs(&args.out, meta, &rows, &args.out)?;
     write_stdout(&table_text(&rows))?;

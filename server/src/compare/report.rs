@@ -43,6 +43,18 @@ pre {{ background: #f7f7f7; padding: 8px; font-size: 11px; overflow-x: auto; }}
         rows.len(),
         distinct(rows.iter().map(|r| r.scene.as_str())).len()
     );
+    if let Some(list) = doc["not_run"].as_array().filter(|l| !l.is_empty()) {
+        h.push_str("<p><strong>Not run on this machine:</strong></p>\n<ul>\n");
+        for n in list {
+            let _ = writeln!(
+                h,
+                "<li><code>{}</code>: {}</li>",
+                escape(n["algorithm"].as_str().unwrap_or("")),
+                escape(n["reason"].as_str().unwrap_or(""))
+            );
+        }
+        h.push_str("</ul>\n");
+    }
     fig9(&mut h, rows);
     edge_maps(&mut h, rows, maps_root);
     if let Some(svg) = aa_svg {

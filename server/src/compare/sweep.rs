@@ -87,6 +87,8 @@ impl ViewportChoice {
 pub struct Sweep {
     pub scenes: Vec<String>,
     pub entries: Vec<Entry>,
+    /// Algorithms left out because this machine cannot run them.
+    pub not_run: Vec<NotRun>,
     pub viewports: Vec<ViewportChoice>,
     pub aa: Vec<AaMode>,
     /// f32 first: the other precisions' rows relate to its times.
@@ -117,7 +119,7 @@ impl Sweep {
         } else {
             file.scenes.clone()
         };
-        let entries = parse_entries(file.algorithms.as_deref().unwrap_or_default())?;
+        let (entries, not_run) = parse_entries(file.algorithms.as_deref().unwrap_or_default())?;
         let viewports = match &file.viewports {
             None => vec![ViewportChoice::Camera],
             Some(list) if list.is_empty() => return Err(bad("viewports", "is empty".into())),
@@ -173,6 +175,7 @@ impl Sweep {
         Ok(Sweep {
             scenes,
             entries,
+            not_run,
             viewports,
             with_reference: aa.iter().any(|&m| m != AaMode::None),
             aa,
@@ -246,33 +249,60 @@ impl Shard {
     }
 }
 
-/// Algorithm ids and peers; empty means every algorithm and every peer this
-/// binary was built with.
-pub fn parse_entries(names: &[String]) -> Result<Vec<Entry>, CliError> {
+/// An algorithm this machine cannot run, left out of a sweep that did not name it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NotRun {
+    pub algorithm: String,
+    pub reason: String,
+}
+
+/// Algorithm ids and peers; empty means every algorithm this machine can run
+/// (the others come back as [`NotRun`]) and every peer this binary was built
+/// with. A named algorithm that cannot run here is an error.
+pub fn parse_entries(names: &[String]) -> Result<(Vec<Entry>, Vec<NotRun>), CliError> {
     if names.is_empty() {
-        let mut all: Vec<Entry> = AlgorithmId::ALL.into_iter().map(Entry::Algorithm).collect();
+        let mut all = Vec::new();
+        let mut not_run = Vec::new();
+        for a in AlgorithmId::ALL {
+            match continuum::unavailable(a) {
+                None => all.push(Entry::Algorithm(a)),
+                Some(reason) => not_run.push(NotRun {
+                    algorithm: a.as_str().into(),
+                    reason,
+                }),
+            }
+        }
         all.extend(
             PeerId::ALL
                 .into_iter()
                 .filter(|p| p.available())
                 .map(Entry::Peer),
         );
-        return Ok(all);
+        return Ok((all, not_run));
     }
-    names
+    let entries = names
         .iter()
         .map(|n| match PeerId::parse(n) {
             Some(p) if !p.available() => Err(CliError::Usage(format!(
                 "algorithms: {n} needs continuum built with --features embree (and Debian's libembree-dev)"
             ))),
             Some(p) => Ok(Entry::Peer(p)),
-            None => parse_algorithm(n).map(Entry::Algorithm).map_err(|e| {
-                CliError::Usage(format!(
-                    "algorithms: {}; peers are: {}",
-                    e.message,
-                    PeerId::ALL.map(|p| p.as_str()).join(", ")
-                ))
-            }),
+            None => {
+                let a = parse_algorithm(n).map_err(|e| {
+                    CliError::Usage(format!(
+                        "algorithms: {}; peers are: {}",
+                        e.message,
+                        PeerId::ALL.map(|p| p.as_str()).join(", ")
+                    ))
+                })?;
+                match continuum::unavailable(a) {
+                    Some(reason) => Err(CliError::Usage(format!(
+                        "algorithms: {n} cannot run on this machine: {reason}"
+                    ))),
+                    None => Ok(Entry::Algorithm(a)),
+                }
+            }
         })
-        .collect()
+        .collect::<Result<_, _>>()?;
+    Ok((entries, Vec::new()))
 }
