@@ -46,7 +46,9 @@ pub use camera::{Camera, View};
 pub use framebuffer::{BACKGROUND, Framebuffer};
 pub use precision::Precision;
 pub use prepared::PreparedScene;
-pub use render::{RenderError, RenderOutput, RenderRequest, render, render_cancellable, unavailable};
+pub use render::{
+    RenderError, RenderOutput, RenderRequest, render, render_cancellable, unavailable,
+};
 pub use scene::{Scene, SceneError};
 pub use stats::{Hashes, Stats};
 pub use viewport::Viewport;

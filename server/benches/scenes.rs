@@ -22,7 +22,10 @@ fn listing(c: &mut Criterion) {
     group.bench_function("catalogue (the listing)", |b| {
         b.iter(|| {
             let state = AppState::new(scenes_dir(), Limits::default());
-            let listed: usize = names.iter().map(|n| state.describe(n)["triangles"].as_u64().unwrap_or(0) as usize).sum();
+            let listed: usize = names
+                .iter()
+                .map(|n| state.describe(n)["triangles"].as_u64().unwrap_or(0) as usize)
+                .sum();
             assert_eq!(state.prepared_count(), 0);
             listed
         });

