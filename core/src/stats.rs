@@ -156,8 +156,8 @@ pub struct RasterCounters {
     pub nodes_culled_outside: u64,
     /// BVH nodes culled because the hierarchical w-buffer hides them.
     pub nodes_culled_occluded: u64,
-    /// 3D edge tests within the f32 rounding bound of zero, decided again in
-    /// f64 (README: "Precision and exactness").
+    /// 3D (and homogeneous) edge tests within the f32 rounding bound of
+    /// zero, decided again in f64 (README: "Precision and exactness").
     pub edge_tests_f64: u64,
     /// Of those, the ones f64 could not decide either: decided exactly.
     pub edge_tests_exact: u64,

@@ -28,9 +28,10 @@ pub(crate) use edge3d::EPS;
 pub use edge3d::Triangle3D;
 pub use edge3d_f64::Triangle3D64;
 pub use homogeneous::setup_homogeneous;
+pub(crate) use homogeneous::{HomogeneousVertex, setup_homogeneous_from};
 
 thread_local! {
-    /// This thread's running count of 3D edge tests the f32 sign could not
+    /// This thread's running count of 3D (and homogeneous) edge tests the f32 sign could not
     /// decide: `[evaluated in f64, of those decided exactly]`.
     static PRECISE_TESTS: std::cell::Cell<[u64; 2]> = const { std::cell::Cell::new([0, 0]) };
 }
@@ -50,7 +51,6 @@ fn count_precise(exactly: bool) {
 pub(crate) fn precise_tests() -> [u64; 2] {
     PRECISE_TESTS.with(std::cell::Cell::get)
 }
-pub(crate) use homogeneous::{HomogeneousVertex, setup_homogeneous_from};
 
 /// Up to eight triangles to set up together, one per lane: their corners,
 /// their mesh vertex indices, and which lanes hold one (bit `l`: lane `l`).

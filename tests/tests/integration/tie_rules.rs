@@ -1,7 +1,7 @@
 //! The top-left rule: pixel centres exactly on edges and vertices go to exactly
 //! one triangle, the Direct3D way, in every algorithm.
 
-use continuum::{AlgorithmId, BACKGROUND};
+use continuum::{AlgorithmId, BACKGROUND, Family};
 use continuum_tests::{exact_camera, pixel_point, render_with, scene_from_triangles};
 use glam::Vec3;
 
@@ -74,6 +74,7 @@ fn fan_around_a_vertex_on_a_pixel_centre_covers_each_pixel_once() {
     positions.extend(ring);
     let triangles: Vec<[u32; 3]> = (0..8).map(|k| [0, 1 + k, 1 + (k + 1) % 8]).collect();
     let scene = scene_from_triangles(positions, triangles, exact_camera());
+    let mut three_d = 0;
     for algorithm in AlgorithmId::ALL {
         let out = render_with(&scene, algorithm, &exact_camera(), 8, 8);
         let fb = &out.framebuffer;
@@ -88,5 +89,25 @@ fn fan_around_a_vertex_on_a_pixel_centre_covers_each_pixel_once() {
                 );
             }
         }
+        // The centre vertex lies exactly on a pixel centre's ray: the 3D and
+        // homogeneous families decide their edges there past f32, some
+        // exactly, and count them (README: "Precision and exactness"); the
+        // 2D family and the GPU have no such path.
+        let c = &out.stats.counters;
+        if matches!(algorithm.family(), Family::ThreeD | Family::Homogeneous) {
+            three_d += 1;
+            assert!(c.edge_tests_exact > 0, "{algorithm}: {c:?}");
+            assert!(c.edge_tests_f64 >= c.edge_tests_exact, "{algorithm}: {c:?}");
+        } else {
+            assert_eq!(
+                (c.edge_tests_f64, c.edge_tests_exact),
+                (0, 0),
+                "{algorithm}"
+            );
+        }
     }
+    assert_eq!(
+        three_d, 7,
+        "2dr-homogeneous, the five 3D rasterizers and raycast"
+    );
 }
