@@ -236,15 +236,20 @@ impl AppState {
         if let Ok(Some(p)) = self.cache().map(|mut c| c.get(name)) {
             return self.remember(name, &p.scene, p.triangle_count());
         }
+        let error = |e: String| Arc::new(serde_json::json!({ "name": name, "error": e }));
+        // A name, never a path: only the scenes folder's scenes load from disk.
+        if !continuum::scene::builtin_names(&self.scenes_dir)
+            .iter()
+            .any(|n| n == name)
+        {
+            return error(format!("unknown scene '{name}'"));
+        }
         match continuum::scene::load_named_or_path(name, &self.scenes_dir) {
             Ok(scene) => {
                 let triangles = scene.mesh.triangle_count();
                 self.remember(name, &scene, triangles)
             }
-            Err(e) => Arc::new(serde_json::json!({
-                "name": name,
-                "error": format!("scene '{name}' failed to load: {e}"),
-            })),
+            Err(e) => error(format!("scene '{name}' failed to load: {e}")),
         }
     }
 
@@ -262,7 +267,7 @@ impl AppState {
         entry
     }
 
-    /// Is any prepared scene cached? (Tests check that listing prepares none.)
+    /// How many prepared scenes are cached (tests check that listing prepares none).
     #[doc(hidden)]
     pub fn prepared_count(&self) -> usize {
         self.cache_usage().0
