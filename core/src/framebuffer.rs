@@ -199,6 +199,23 @@ pub(crate) struct ResolvedTile {
     pub effects: crate::shade::plan::EffectCounters,
 }
 
+impl ResolvedTile {
+    /// A tile of `rect` left empty (zeroed buffers, nothing counted): what a
+    /// cancelled render stores for the tiles it no longer renders.
+    pub(crate) fn blank(rect: [u32; 4]) -> ResolvedTile {
+        let n = (rect[2] - rect[0]) as usize * (rect[3] - rect[1]) as usize;
+        ResolvedTile {
+            rect,
+            color: vec![[0; 4]; n],
+            depth: vec![0.0; n],
+            triangle_id: vec![0; n],
+            edge_evals: vec![0; n],
+            coverage_writes: vec![0; n],
+            ..ResolvedTile::default()
+        }
+    }
+}
+
 /// A covered sample of a see-through triangle: kept beside the w-buffer, not
 /// tested against it, until the resolve sorts the sample's fragments by depth
 /// and blends those in front of its opaque surface (an A-buffer).

@@ -546,11 +546,12 @@ fn slow_renders_time_out_with_504() {
 
 #[test]
 fn a_render_answered_504_is_cancelled_and_frees_its_slot() {
-    // One slot; a following request waits at most the timeout for it.
+    // One slot; a 1 s timeout; room for a render of a billion samples.
     let s = state(Limits {
         max_concurrent_renders: 1,
         max_queued_renders: 1,
         render_timeout: Duration::from_secs(1),
+        max_samples: 1 << 31,
         ..Limits::default()
     });
     for scene in ["teapots", "box"] {
@@ -558,16 +559,27 @@ fn a_render_answered_504_is_cancelled_and_frees_its_slot() {
             .prepared(scene)
             .expect("prepared ahead, outside the timeout");
     }
-    // Seconds of work: a million triangles at 2560x1600 with 16 samples per pixel.
+    // Far more than a second of work, uncancelled: a million triangles at
+    // 2560x1600 with 64 samples per pixel (262M samples).
     let (status, doc) = post(
         &s,
         "/api/render",
-        r#"{ "scene": "teapots", "algorithm": "3dr-brute", "size": "2560x1600", "aa": "ssaa:16" }"#,
+        r#"{ "scene": "teapots", "algorithm": "3dr-brute", "size": "2560x1600", "aa": "ssaa:64" }"#,
     );
     assert_eq!(status, StatusCode::GATEWAY_TIMEOUT, "{doc}");
     assert_eq!(doc["field"], "timeout", "{doc}");
-    // The cancelled render gives its slot back within a tile's time: this
-    // request gets it within its one-second wait (else 503) and renders.
+    // The cancelled render stops at its next tile and gives its slot back:
+    // within a second here, polled for up to five so a loaded machine does
+    // not fail it (the render itself would take tens of seconds).
+    let slots = s.state.renders_for_test();
+    let answered = std::time::Instant::now();
+    while slots.available_permits() == 0 {
+        assert!(
+            answered.elapsed() < Duration::from_secs(5),
+            "the cancelled render still holds its slot"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
     let (status, doc) = post(
         &s,
         "/api/render",

@@ -485,7 +485,7 @@ pub(crate) struct TileContext<'a> {
     /// Opacity per triangle id (empty: every triangle opaque).
     pub opacity: &'a [f32],
     /// Set by the caller to abandon the render: tiles not yet started are
-    /// left empty (checked once per tile or band).
+    /// neither rendered nor resolved (checked once per tile or band).
     pub cancel: &'a std::sync::atomic::AtomicBool,
 }
 
@@ -524,6 +524,16 @@ impl<'a> TileContext<'a> {
         (x0, y0, x1, y1): (u32, u32, u32, u32),
         render: impl FnOnce(&mut TileBuffer<'a>) -> R,
     ) -> Finished<R> {
+        // A cancelled render neither renders nor resolves what is left.
+        if self.cancel.load(std::sync::atomic::Ordering::Relaxed) {
+            return Finished {
+                resolved: ResolvedTile::blank([x0, y0, x1, y1]),
+                result: R::default(),
+                precise: [0; 2],
+                render_s: 0.0,
+                resolve_s: 0.0,
+            };
+        }
         let start = Instant::now();
         let tile = match cache {
             Some(tile) => {
@@ -536,13 +546,8 @@ impl<'a> TileContext<'a> {
                 self.opacity,
             )),
         };
-        let cancelled = self.cancel.load(std::sync::atomic::Ordering::Relaxed);
         let precise = crate::edge::precise_tests();
-        let result = if cancelled {
-            R::default()
-        } else {
-            render(tile)
-        };
+        let result = render(tile);
         let precise_after = crate::edge::precise_tests();
         let render_s = start.elapsed().as_secs_f64();
         let start = Instant::now();
