@@ -49,7 +49,9 @@ cid=$(docker run -d -p 127.0.0.1::8080 "$image" "${args[@]}")
 port=$(docker port "$cid" 8080/tcp | head -n 1 | sed 's/.*://')
 for _ in $(seq 60); do curl -sf "http://127.0.0.1:$port/healthz" >/dev/null && break; sleep 1; done
 curl -sf "http://127.0.0.1:$port/healthz" >/dev/null || { docker logs "$cid"; echo "k8s: the Deployment's container is not healthy"; exit 1; }
-docker logs "$cid" 2>&1 | head -n 1 | grep -q '^{' || { docker logs "$cid"; echo "k8s: --log-format json did not log JSON"; exit 1; }
+# The log is standard error (standard output has the URL line): JSON objects only.
+logs=$(docker logs "$cid" 2>&1 >/dev/null)
+[ -n "$logs" ] && ! grep -qv '^{' <<<"$logs" || { echo "$logs"; echo "k8s: --log-format json did not log JSON lines"; exit 1; }
 docker rm -f "$cid" >/dev/null; cid=""
 echo "k8s: the Deployment's container serves /healthz with its manifest's args"
 
