@@ -597,6 +597,8 @@ fn every_error_status_answers_error_and_field_as_json() {
     });
     let big = vec![b'x'; 4 << 10];
     let render = br#"{ "scene": "box", "algorithm": "raycast", "size": "16x16" }"#;
+    // Slow enough never to beat the 1 ns timeout (a 16x16 box render can).
+    let slow = br#"{ "scene": "teapots", "algorithm": "2dr-brute", "size": "640x480" }"#;
     /// Method, path, content type, body → status and the field named.
     type Case<'a> = (&'a str, &'a str, &'a str, &'a [u8], StatusCode, &'a str);
     let cases: [Case; 7] = [
@@ -652,7 +654,7 @@ fn every_error_status_answers_error_and_field_as_json() {
             "POST",
             "/api/render",
             "application/json; charset=utf-8",
-            render,
+            slow,
             StatusCode::GATEWAY_TIMEOUT,
             "timeout",
         ),
