@@ -65,7 +65,9 @@ if [ -z "${DISPLAY:-}" ]; then
 fi
 
 # 4. Vulkan must be there: the GPU tests fail loudly without it, and this says why first.
-vulkaninfo --summary 2>/dev/null | grep -qE "deviceName" \
+# (Read whole before grep: `grep -q` quitting early would SIGPIPE vulkaninfo and fail the pipe.)
+vulkan="$(vulkaninfo --summary 2>/dev/null || true)"
+grep -qE "deviceName" <<<"$vulkan" \
     || { echo "error: no Vulkan device (Debian: mesa-vulkan-drivers libvulkan1)" >&2; exit 1; }
 
 # 5. The tests.
