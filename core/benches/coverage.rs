@@ -1,40 +1,19 @@
 //! The per-sample coverage kernel on its two instruction sets: 3D edge
 //! functions (paper §3.2) over every row of a 256×192 image for random
-//! triangles, through [`Coverage::sample_run`] on the portable lanes and on
-//! AVX2 (`cargo bench -p continuum-core --bench coverage`). Both count the
-//! same covered samples; the bench asserts it before timing.
+//! triangles, through `sample_run` on the portable lanes and on AVX2
+//! (`cargo bench -p continuum-core --bench coverage`), reached through
+//! `continuum::internal::covered_samples`, which checks the CPU itself. Both
+//! count the same covered samples; the bench asserts it before timing.
 
 use std::hint::black_box;
 
-use continuum::View;
-use continuum::camera::{Camera, Viewport};
-use continuum::edge::{Coverage, Triangle3D};
-use continuum::simd::{self, Lanes, Portable};
+use continuum::internal::{Isa, Triangle3D, covered_samples};
+use continuum::{Camera, View, Viewport};
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 
 const WIDTH: u32 = 256;
 const HEIGHT: u32 = 192;
-
-/// Covered samples of every triangle over the whole image, row by row.
-#[inline(always)]
-fn covered<L: Lanes>(triangles: &[Triangle3D]) -> u64 {
-    let mut covered = 0u64;
-    for t in triangles {
-        for y in 0..HEIGHT {
-            t.sample_run::<L>(0.5, y as f32 + 0.5, WIDTH, |_, w| {
-                covered += u64::from(w > 0.0);
-            });
-        }
-    }
-    covered
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn covered_avx2(triangles: &[Triangle3D]) -> u64 {
-    covered::<simd::Avx2>(triangles)
-}
 
 fn coverage(c: &mut Criterion) {
     let camera = Camera {
@@ -66,21 +45,18 @@ fn coverage(c: &mut Criterion) {
         .collect();
 
     let mut group = c.benchmark_group("coverage/sample_run");
-    let portable = covered::<Portable>(&triangles);
+    let portable = covered_samples(&triangles, WIDTH, HEIGHT, Isa::Portable);
     group.bench_function("portable", |b| {
-        b.iter(|| covered::<Portable>(black_box(&triangles)));
+        b.iter(|| covered_samples(black_box(&triangles), WIDTH, HEIGHT, Isa::Portable));
     });
-    #[cfg(target_arch = "x86_64")]
-    if simd::cpu_has_avx2() {
-        // SAFETY: the CPU has AVX2 (checked just now).
-        let avx2 = unsafe { covered_avx2(&triangles) };
+    if let Some(avx2) = covered_samples(&triangles, WIDTH, HEIGHT, Isa::Avx2) {
         assert_eq!(
-            portable, avx2,
+            portable,
+            Some(avx2),
             "the two instruction sets cover different samples"
         );
         group.bench_function("avx2", |b| {
-            // SAFETY: as above.
-            b.iter(|| unsafe { covered_avx2(black_box(&triangles)) });
+            b.iter(|| covered_samples(black_box(&triangles), WIDTH, HEIGHT, Isa::Avx2));
         });
     }
     group.finish();

@@ -6,43 +6,15 @@
 //! tested one by one. With early-z a block is skipped when the triangle's nearest
 //! possible depth lies behind everything the hierarchical w-buffer holds there.
 
-use crate::algorithm::PixelRect;
 use crate::edge::{BlockTest, Coverage};
 use crate::framebuffer::{SCRATCH_PIXELS, TileBuffer};
+use crate::ground::PixelRect;
+use crate::pipeline::SampleOracles;
 use crate::simd::{self, Lanes, first_lanes};
 use crate::stats::RasterCounters;
 
-/// How samples are enumerated inside a triangle's box.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct SampleOracles {
-    /// Hierarchical tile tests instead of testing every sample of the box.
-    pub binning: bool,
-    /// Blocks of this many pixels square (a power of two) are tested sample by sample.
-    pub leaf: u32,
-    /// Skip blocks that the hierarchical w-buffer shows are hidden.
-    pub early_z: bool,
-    /// Parabolic viewport: evaluate edges along rows with the double-incremental
-    /// scheme of §3.5 eq. 3 (same decisions as direct evaluation).
-    pub incremental: bool,
-}
-
-impl SampleOracles {
-    pub const BRUTE: SampleOracles = SampleOracles {
-        binning: false,
-        leaf: 8,
-        early_z: false,
-        incremental: false,
-    };
-    pub const BINNED: SampleOracles = SampleOracles {
-        binning: true,
-        leaf: 8,
-        early_z: true,
-        incremental: false,
-    };
-}
-
 /// Rasterizes `tri` (id `id`, screen box `rect`) into `tile`, limited to
-/// `clip` (inclusive pixel bounds inside the tile).
+/// `clip` (pixels inside the tile).
 pub(crate) fn raster_triangle<T: Coverage>(
     tile: &mut TileBuffer,
     tri: &T,
@@ -58,7 +30,7 @@ pub(crate) fn raster_triangle<T: Coverage>(
     // Start from the smallest block of the tile's power-of-two hierarchy that
     // holds the triangle's box ("binning starting from the bounding box").
     let (lx0, ly0) = (clip.x0 - tile.x0, clip.y0 - tile.y0);
-    let (lx1, ly1) = (clip.x1 - tile.x0, clip.y1 - tile.y0);
+    let (lx1, ly1) = (clip.x1 - 1 - tile.x0, clip.y1 - 1 - tile.y0);
     let mut side = oracles.leaf.max(1);
     while lx0 / side != lx1 / side || ly0 / side != ly1 / side {
         side *= 2;
@@ -84,7 +56,7 @@ fn sample_block<T: Coverage>(
     }
     let covered = test_samples(tile, tri, id, r);
     if oracles.early_z {
-        tile.update_hiz(r.x0, r.y0, r.x1, r.y1);
+        tile.update_hiz(r);
     }
     covered
 }
@@ -98,7 +70,7 @@ fn early_z_rejects<T: Coverage>(
     r: PixelRect,
     counters: &mut RasterCounters,
 ) -> bool {
-    if tri.min_depth() > tile.hiz_max(r.x0, r.y0, r.x1, r.y1) {
+    if tri.min_depth() > tile.hiz_max(r) {
         counters.early_z_rejects += 1;
         return true;
     }
@@ -126,8 +98,8 @@ fn test_samples_on<L: Lanes, T: Coverage>(
     // One sample per pixel: runs along rows (which curved edges may evaluate
     // incrementally, §3.5 eq. 3).
     let mut covered = 0;
-    let n = r.x1 - r.x0 + 1;
-    for y in r.y0..=r.y1 {
+    let n = r.width();
+    for y in r.y0..r.y1 {
         let i = tile.index(r.x0, y);
         for count in &mut tile.edge_evals[i..i + n as usize] {
             *count += 1;
@@ -193,9 +165,9 @@ fn sample_pattern<L: Lanes, T: Coverage>(
     let mut masks = std::mem::take(&mut tile.scratch_masks);
     let mut depths = std::mem::take(&mut tile.scratch_depths);
     let mut covered = 0;
-    for y in r.y0..=r.y1 {
-        for x0 in (r.x0..=r.x1).step_by(CHUNK as usize) {
-            let n = (r.x1 - x0 + 1).min(CHUNK) as usize;
+    for y in r.y0..r.y1 {
+        for x0 in (r.x0..r.x1).step_by(CHUNK as usize) {
+            let n = (r.x1 - x0).min(CHUNK) as usize;
             let i = tile.index(x0, y);
             for evals in &mut tile.edge_evals[i..i + n] {
                 *evals += count as u32;
@@ -276,7 +248,8 @@ fn sample_pattern<L: Lanes, T: Coverage>(
 /// "binning"; curved edges §3.5), each corner pixel charged one evaluation.
 #[inline]
 fn test_block<T: Coverage>(tile: &mut TileBuffer, tri: &T, r: PixelRect) -> BlockTest {
-    for (x, y) in [(r.x0, r.y0), (r.x1, r.y0), (r.x0, r.y1), (r.x1, r.y1)] {
+    let (x1, y1) = (r.x1 - 1, r.y1 - 1);
+    for (x, y) in [(r.x0, r.y0), (x1, r.y0), (r.x0, y1), (x1, y1)] {
         let i = tile.index(x, y);
         tile.edge_evals[i] += 1;
     }
@@ -284,8 +257,8 @@ fn test_block<T: Coverage>(tile: &mut TileBuffer, tri: &T, r: PixelRect) -> Bloc
     tri.classify_block(
         r.x0 as f32 + span.lo[0],
         r.y0 as f32 + span.lo[1],
-        r.x1 as f32 + span.hi[0],
-        r.y1 as f32 + span.hi[1],
+        x1 as f32 + span.hi[0],
+        y1 as f32 + span.hi[1],
     )
 }
 
@@ -305,12 +278,7 @@ fn bin_block<T: Coverage>(
     counters: &mut RasterCounters,
 ) -> u32 {
     // 1. The block's samples inside the triangle's box.
-    let block = PixelRect {
-        x0: bx,
-        y0: by,
-        x1: bx + side - 1,
-        y1: by + side - 1,
-    };
+    let block = PixelRect::new(bx, by, bx + side, by + side);
     let Some(r) = block.intersect(clip) else {
         return 0;
     };
@@ -333,7 +301,7 @@ fn bin_block<T: Coverage>(
             counters.tiles_accepted += 1;
             let written = fill_samples(tile, tri, id, r);
             if oracles.early_z {
-                tile.update_hiz(r.x0, r.y0, r.x1, r.y1);
+                tile.update_hiz(r);
             }
             written
         }

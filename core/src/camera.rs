@@ -11,7 +11,7 @@
 
 use glam::{DVec3, Vec3};
 
-use crate::scene::Bounds;
+use crate::ground::{Bounds, FieldError};
 pub use crate::viewport::{SphereMap, Viewport};
 
 /// A named camera: where it is, what it looks at, and how pixels map to rays.
@@ -28,19 +28,10 @@ pub struct Camera {
     pub near: Option<f32>,
 }
 
-/// A camera value that cannot be used, with the field at fault.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("camera {field}: {message}")]
-pub struct CameraError {
-    pub field: &'static str,
-    pub message: String,
-}
-
-fn camera_error(field: &'static str, message: impl Into<String>) -> CameraError {
-    CameraError {
-        field,
-        message: message.into(),
-    }
+/// A camera field that cannot be used: the error names the request field
+/// `camera` and, first in its message, the camera's own field.
+fn camera_error(field: &str, message: impl Into<String>) -> FieldError {
+    FieldError::new("camera", format!("{field}: {}", message.into()))
 }
 
 impl Camera {
@@ -80,7 +71,7 @@ impl Camera {
     }
 
     /// Checks every field; the error names the first one at fault.
-    pub fn validate(&self) -> Result<(), CameraError> {
+    pub fn validate(&self) -> Result<(), FieldError> {
         for (field, v) in [("eye", self.eye), ("target", self.target), ("up", self.up)] {
             if !v.is_finite() {
                 return Err(camera_error(field, format!("must be finite, got {v}")));
@@ -102,7 +93,7 @@ impl Camera {
         }
         self.viewport
             .validate()
-            .map_err(|m| camera_error("viewport", m))?;
+            .map_err(|e| camera_error("viewport", e.message))?;
         if let Some(near) = self.near
             && !(near > 0.0 && near.is_finite())
         {
@@ -163,10 +154,10 @@ impl View {
         width: u32,
         height: u32,
         default_near: f32,
-    ) -> Result<View, CameraError> {
+    ) -> Result<View, FieldError> {
         camera.validate()?;
         if width == 0 || height == 0 {
-            return Err(camera_error("size", "width and height must be positive"));
+            return Err(FieldError::new("size", "width and height must be positive"));
         }
         // The basis in f64 (no overflow for huge coordinates), rounded once.
         let forward64 = (camera.target.as_dvec3() - camera.eye.as_dvec3()).normalize();

@@ -3,7 +3,9 @@
 //! (watertightness: a closed mesh gives exactly one per sample).
 
 use crate::aa::SamplePattern;
-use crate::stats::CoverageHistogram;
+use crate::ground::PixelRect;
+use crate::prepared::is_see_through;
+use crate::stats::{CoverageHistogram, Hashes};
 
 /// Triangle id of a pixel no triangle covers.
 pub const BACKGROUND: u32 = u32::MAX;
@@ -14,13 +16,6 @@ pub const BACKGROUND: u32 = u32::MAX;
 #[inline(always)]
 pub fn wins_depth_test(w: f32, id: u32, depth: f32, stored_id: u32) -> bool {
     w < depth || (w == depth && id < stored_id)
-}
-
-/// Whether triangle `id` is see-through under the per-triangle `opacity`
-/// (empty: every triangle opaque).
-#[inline(always)]
-pub(crate) fn is_see_through(opacity: &[f32], id: u32) -> bool {
-    !opacity.is_empty() && opacity[id as usize] < 1.0
 }
 
 /// All per-pixel buffers of one render, row-major, `y` down. With anti-aliasing
@@ -72,13 +67,13 @@ impl Framebuffer {
         }
     }
 
-    /// The image cut into `size × size` tiles (smaller at the right and bottom),
-    /// as `(x0, y0, x1, y1)` with exclusive ends, row by row.
-    pub fn tile_rects(&self, size: u32) -> Vec<(u32, u32, u32, u32)> {
+    /// The image cut into `size × size` tiles (smaller at the right and
+    /// bottom), row by row.
+    pub fn tile_rects(&self, size: u32) -> Vec<PixelRect> {
         let mut rects = Vec::new();
         for y0 in (0..self.height).step_by(size as usize) {
             for x0 in (0..self.width).step_by(size as usize) {
-                rects.push((
+                rects.push(PixelRect::new(
                     x0,
                     y0,
                     (x0 + size).min(self.width),
@@ -111,10 +106,7 @@ impl Framebuffer {
     /// overlap; together they cover the image (checked by area).
     pub(crate) fn store_tiles(&mut self, tiles: &[ResolvedTile]) {
         let (width, height) = (self.width as usize, self.height as usize);
-        let area = |t: &ResolvedTile| {
-            let [x0, y0, x1, y1] = t.rect;
-            (x1 - x0) as usize * (y1 - y0) as usize
-        };
+        let area = |t: &ResolvedTile| t.rect.width() as usize * t.rect.height() as usize;
         assert_eq!(
             tiles.iter().map(area).sum::<usize>(),
             width * height,
@@ -123,8 +115,7 @@ impl Framebuffer {
         // Per row, the tiles holding it.
         let mut rows: Vec<Vec<&ResolvedTile>> = vec![Vec::new(); height];
         for t in tiles {
-            let [_, y0, _, y1] = t.rect;
-            for row in &mut rows[y0 as usize..y1 as usize] {
+            for row in &mut rows[t.rect.y0 as usize..t.rect.y1 as usize] {
                 row.push(t);
             }
         }
@@ -169,7 +160,7 @@ fn store_rows<T: Copy + Send + Sync>(
                 if src.is_empty() {
                     continue;
                 }
-                let [x0, y0, x1, _] = t.rect.map(|v| v as usize);
+                let (x0, y0, x1) = (t.rect.x0 as usize, t.rect.y0 as usize, t.rect.x1 as usize);
                 let w = x1 - x0;
                 let start = (y - y0) * w;
                 row[x0..x1].copy_from_slice(&src[start..start + w]);
@@ -181,8 +172,7 @@ fn store_rows<T: Copy + Send + Sync>(
 /// what the resolve counted.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ResolvedTile {
-    /// `[x0, y0, x1, y1]`, exclusive ends.
-    pub rect: [u32; 4],
+    pub rect: PixelRect,
     pub color: Vec<[u8; 4]>,
     pub depth: Vec<f32>,
     pub triangle_id: Vec<u32>,
@@ -196,14 +186,14 @@ pub(crate) struct ResolvedTile {
     /// Shading evaluations made.
     pub shading_samples: u64,
     /// What the tile's effect rays cost.
-    pub effects: crate::shade::plan::EffectCounters,
+    pub effects: crate::effects::EffectCounters,
 }
 
 impl ResolvedTile {
     /// A tile of `rect` left empty (zeroed buffers, nothing counted): what a
     /// cancelled render stores for the tiles it no longer renders.
-    pub(crate) fn blank(rect: [u32; 4]) -> ResolvedTile {
-        let n = (rect[2] - rect[0]) as usize * (rect[3] - rect[1]) as usize;
+    pub(crate) fn blank(rect: PixelRect) -> ResolvedTile {
+        let n = rect.width() as usize * rect.height() as usize;
         ResolvedTile {
             rect,
             color: vec![[0; 4]; n],
@@ -280,10 +270,10 @@ pub struct TileBuffer<'p> {
 }
 
 impl<'p> TileBuffer<'p> {
-    /// Buffers for the pixels `x0..x1 × y0..y1`; `opacity` per triangle id
+    /// Buffers for the pixels of `rect`; `opacity` per triangle id
     /// (empty: all opaque) tells which triangles leave fragments.
     pub fn new(
-        (x0, y0, x1, y1): (u32, u32, u32, u32),
+        PixelRect { x0, y0, x1, y1 }: PixelRect,
         pattern: &'p SamplePattern,
         opacity: &'p [f32],
     ) -> TileBuffer<'p> {
@@ -332,7 +322,7 @@ impl<'p> TileBuffer<'p> {
 
     /// The same buffers for the pixels `x0..x1 × y0..y1`, cleared (their
     /// memory kept).
-    pub fn reset(&mut self, x0: u32, y0: u32, x1: u32, y1: u32) {
+    pub fn reset(&mut self, PixelRect { x0, y0, x1, y1 }: PixelRect) {
         let pixels = ((x1 - x0) * (y1 - y0)) as usize;
         let samples = pixels * self.pattern.stored;
         let refill = |v: &mut Vec<u32>, n: usize, value: u32| {
@@ -357,14 +347,9 @@ impl<'p> TileBuffer<'p> {
         self.depth_lowered = false;
     }
 
-    /// The tile's pixels as an inclusive rectangle.
-    pub(crate) fn rect(&self) -> crate::algorithm::PixelRect {
-        crate::algorithm::PixelRect {
-            x0: self.x0,
-            y0: self.y0,
-            x1: self.x1 - 1,
-            y1: self.y1 - 1,
-        }
+    /// The tile's pixels.
+    pub(crate) fn rect(&self) -> PixelRect {
+        PixelRect::new(self.x0, self.y0, self.x1, self.y1)
     }
 
     /// Index of pixel `(x, y)` (screen coordinates) in the tile's per-pixel
@@ -410,31 +395,39 @@ impl<'p> TileBuffer<'p> {
         }
     }
 
-    /// The farthest stored depth over the cells that pixels `[x0, x1] × [y0, y1]`
-    /// (inclusive, screen coordinates) touch.
-    pub fn hiz_max(&self, x0: u32, y0: u32, x1: u32, y1: u32) -> f32 {
-        let (cx0, cx1) = ((x0 - self.x0) / HIZ_CELL, (x1 - self.x0) / HIZ_CELL);
-        let (cy0, cy1) = ((y0 - self.y0) / HIZ_CELL, (y1 - self.y0) / HIZ_CELL);
+    /// The hierarchical w-buffer cells (columns, rows; half-open) that the
+    /// pixels of the non-empty `r` (screen coordinates, inside the tile) touch.
+    #[inline]
+    fn hiz_cells(&self, r: PixelRect) -> (std::ops::Range<u32>, std::ops::Range<u32>) {
+        let cell = |v: u32, origin: u32| (v - origin) / HIZ_CELL;
+        (
+            cell(r.x0, self.x0)..cell(r.x1 - 1, self.x0) + 1,
+            cell(r.y0, self.y0)..cell(r.y1 - 1, self.y0) + 1,
+        )
+    }
+
+    /// The farthest stored depth over the cells that the pixels of `r` touch.
+    pub fn hiz_max(&self, r: PixelRect) -> f32 {
+        let (columns, rows) = self.hiz_cells(r);
         let mut max = f32::NEG_INFINITY;
-        for cy in cy0..=cy1 {
-            for cx in cx0..=cx1 {
+        for cy in rows {
+            for cx in columns.clone() {
                 max = max.max(self.hiz[(cy * self.hiz_columns + cx) as usize]);
             }
         }
         max
     }
 
-    /// Recomputes the cells that pixels `[x0, x1] × [y0, y1]` touch, if a depth
-    /// has decreased since the last update (every write between two updates
-    /// falls inside the rectangle the second one names).
-    pub fn update_hiz(&mut self, x0: u32, y0: u32, x1: u32, y1: u32) {
+    /// Recomputes the cells that the pixels of `r` touch, if a depth has
+    /// decreased since the last update (every write between two updates falls
+    /// inside the rectangle the second one names).
+    pub fn update_hiz(&mut self, r: PixelRect) {
         if !std::mem::take(&mut self.depth_lowered) {
             return;
         }
-        let (cx0, cx1) = ((x0 - self.x0) / HIZ_CELL, (x1 - self.x0) / HIZ_CELL);
-        let (cy0, cy1) = ((y0 - self.y0) / HIZ_CELL, (y1 - self.y0) / HIZ_CELL);
-        for cy in cy0..=cy1 {
-            for cx in cx0..=cx1 {
+        let (columns, rows) = self.hiz_cells(r);
+        for cy in rows {
+            for cx in columns.clone() {
                 let px0 = self.x0 + cx * HIZ_CELL;
                 let py0 = self.y0 + cy * HIZ_CELL;
                 let px1 = (px0 + HIZ_CELL).min(self.x1);
@@ -454,4 +447,39 @@ impl<'p> TileBuffer<'p> {
             }
         }
     }
+}
+
+impl Hashes {
+    /// xxh3 of the buffers' little-endian bytes, hashed in place (no copy of
+    /// the image) and side by side.
+    pub fn of(fb: &Framebuffer) -> Hashes {
+        let hex = |hash: u64| format!("{hash:016x}");
+        let ((triangle_id, color), digest) = rayon::join(
+            || {
+                rayon::join(
+                    || hash_le(&fb.triangle_id, u32::to_le_bytes),
+                    || xxhash_rust::xxh3::xxh3_64(fb.color.as_flattened()),
+                )
+            },
+            || (!fb.sample_digest.is_empty()).then(|| hash_le(&fb.sample_digest, u64::to_le_bytes)),
+        );
+        Hashes {
+            triangle_id: hex(triangle_id),
+            color: hex(color),
+            samples: hex(digest.unwrap_or(triangle_id)),
+        }
+    }
+}
+
+/// xxh3 of `values` as little-endian bytes, streamed through a small buffer.
+fn hash_le<T: Copy, const N: usize>(values: &[T], bytes: fn(T) -> [u8; N]) -> u64 {
+    let mut hasher = xxhash_rust::xxh3::Xxh3::new();
+    let mut buffer = [0u8; 4096];
+    for chunk in values.chunks(buffer.len() / N) {
+        for (out, &v) in buffer.chunks_exact_mut(N).zip(chunk) {
+            out.copy_from_slice(&bytes(v));
+        }
+        hasher.update(&buffer[..chunk.len() * N]);
+    }
+    hasher.digest()
 }

@@ -3,52 +3,87 @@
 //! It follows "3D Rasterization: A Bridge between Rasterization and Ray Casting"
 //! (Davidovič et al., GI 2012). Coverage is decided by edge functions — projected
 //! 2D ones, or the paper's 3D (Plücker) ones — and the algorithms differ only in
-//! how they enumerate triangles and samples. Every front end calls [`render()`]:
+//! how they enumerate triangles and samples. Every front end turns a user's
+//! words into a request through [`RenderWords`] and calls [`render()`]:
 //!
 //! ```no_run
-//! use continuum::{render, AlgorithmId, PreparedScene, RenderRequest};
+//! use continuum::{AlgorithmId, PreparedScene, RenderRequest, render};
 //! let scene = continuum::scene::load_path("scenes/bunny.toml".as_ref()).unwrap();
 //! let prepared = PreparedScene::new(scene);
 //! let camera = prepared.scene.first_camera();
-//! let out = render(&prepared, &RenderRequest { algorithm: AlgorithmId::ThreeDBrute, oracles: None, camera, width: 640, height: 480, aa: Default::default(), precision: Default::default(), texture_filter: Default::default() }).unwrap();
+//! let request = RenderRequest::new(AlgorithmId::ThreeDBrute, camera, 640, 480);
+//! let out = render(&prepared, &request).unwrap();
 //! println!("{}", out.hashes.triangle_id);
 //! ```
+//!
+//! # Floors
+//! The modules below are declared floor by floor, lowest first, and a module
+//! imports only modules declared before it (`scripts/floors.py`, run by CI,
+//! fails on a back edge or a cycle). ARCHITECTURE.md draws the floors.
 
-pub mod aa;
-pub mod algorithm;
-pub mod binning;
-pub mod bvh;
-pub mod camera;
-pub mod clip;
-pub mod edge;
-pub mod framebuffer;
-#[cfg(feature = "gpu")]
-pub mod gpu;
-pub mod hardcases;
-pub mod maps;
+// floors: lowest first; a module imports only modules declared above it.
+// Floor 0 — vocabulary: the one error type, rectangles, ids, boxes; lanes.
+mod ground;
 pub mod mesa;
-pub mod metrics;
-pub mod peer;
-pub mod precision;
-pub mod prepared;
-pub mod render;
-pub mod request;
+mod simd;
+// Floor 1 — settings a request names.
+mod aa;
+mod color;
+mod pipeline;
+mod precision;
+mod viewport;
+// Floor 2 — geometry and scenes.
+mod camera;
+mod clip;
+mod effects;
+mod request;
 pub mod scene;
-pub mod shade;
-pub mod simd;
-pub mod stats;
-pub mod traversal;
-pub mod viewport;
+mod texture;
+// Floor 3 — edge functions.
+mod edge;
+// Floor 4 — the BVH.
+mod bvh;
+// Floor 5 — the prepared scene.
+mod prepared;
+// Floor 6 — frame buffers, statistics, images of them, screen boxes.
+mod framebuffer;
+pub mod maps;
+pub mod metrics;
+mod screen_boxes;
+mod stats;
+// Floor 7 — the stages: shading, binning, traversal, the anti-aliasing resolve.
+mod binning;
+mod resolve;
+mod shade;
+mod traversal;
+// Floor 8 — the algorithms (the GPU's among them) and their one dispatch.
+mod algorithm;
+#[cfg(feature = "gpu")]
+mod gpu;
+// Floor 9 — what may be rendered, the words a user types, the entry point;
+// kernels for benches and tests.
+mod capability;
+pub mod internal;
+mod render;
+mod words;
 
 pub use aa::AaMode;
-pub use algorithm::{AlgorithmId, Family, Pipeline};
-pub use camera::{Camera, View};
+pub use camera::{Camera, View, pixel_center};
+pub use capability::{check, gpu_adapter, unavailable};
+pub use color::{BACKGROUND_COLOR, decode_srgb};
+pub use effects::EffectStats;
 pub use framebuffer::{BACKGROUND, Framebuffer};
+pub use ground::{AlgorithmId, Bounds, Family, FieldError, MAX_DIMENSION, UnknownAlgorithm};
+pub use pipeline::Oracles;
 pub use precision::Precision;
 pub use prepared::PreparedScene;
-pub use render::{
-    RenderError, RenderOutput, RenderRequest, render, render_cancellable, unavailable,
-};
+pub use render::{RenderOutput, RenderSummary, render, render_cancellable};
+pub use request::RenderRequest;
 pub use scene::{Scene, SceneError};
-pub use stats::{Hashes, Stats};
+pub use simd::{Isa, isa};
+pub use stats::{CoverageHistogram, Hashes, RasterCounters, StageTimes, Stats};
+pub use texture::TextureFilter;
 pub use viewport::Viewport;
+pub use words::{
+    CameraSpec, DEFAULT_SIZE, ExplicitCamera, RenderWords, Settings, parse_algorithm, parse_size,
+};

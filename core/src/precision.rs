@@ -10,8 +10,7 @@
 
 use std::fmt;
 
-use crate::algorithm::{AlgorithmId, Family};
-use crate::request::FieldError;
+use crate::ground::{Family, FieldError};
 
 /// How coverage decisions are computed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -54,22 +53,6 @@ impl Precision {
             Precision::Fixed => family == Family::TwoD,
         }
     }
-
-    /// The error for an algorithm this precision does not serve.
-    pub fn unsupported(self, algorithm: AlgorithmId) -> FieldError {
-        let served: Vec<&str> = AlgorithmId::ALL
-            .into_iter()
-            .filter(|a| self.serves(a.family()))
-            .map(AlgorithmId::as_str)
-            .collect();
-        FieldError::new(
-            "precision",
-            format!(
-                "{algorithm} does not compute in {self}; {self} serves {}",
-                served.join(", ")
-            ),
-        )
-    }
 }
 
 impl fmt::Display for Precision {
@@ -94,6 +77,7 @@ impl<'de> serde::Deserialize<'de> for Precision {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ground::AlgorithmId;
 
     #[test]
     fn words_round_trip_and_errors_name_the_field() {
@@ -109,7 +93,5 @@ mod tests {
         assert!(!Precision::F64.serves(AlgorithmId::TwoDBrute.family()));
         assert!(Precision::Fixed.serves(AlgorithmId::TwoDBin.family()));
         assert!(!Precision::Fixed.serves(AlgorithmId::TwoDHomogeneous.family()));
-        let e = Precision::Fixed.unsupported(AlgorithmId::ThreeDBrute);
-        assert!(e.message.contains("2dr-brute, 2dr-bin"), "{e}");
     }
 }

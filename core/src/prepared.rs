@@ -8,9 +8,10 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::bvh::SceneBvh;
-use crate::scene::{Bounds, Scene};
-use crate::shade::plan::EffectPlan;
-use crate::shade::texture::MipChain;
+use crate::effects::EffectPlan;
+use crate::ground::Bounds;
+use crate::scene::Scene;
+use crate::texture::MipChain;
 
 /// A scene ready to render from any camera.
 #[derive(Debug)]
@@ -41,9 +42,10 @@ pub struct PreparedScene {
     /// Opacity per triangle id, from its material; empty when every material
     /// is opaque (the effect plan runs no transparency then).
     pub triangle_opacity: Vec<f32>,
-    /// The drawable triangles on the GPU, uploaded by the first `gpu-raster` render.
+    /// What the GPU keeps of this scene (its drawable triangles uploaded by
+    /// the first `gpu-raster` render), typed by the floor above that owns it.
     #[cfg(feature = "gpu")]
-    pub(crate) gpu_mesh: std::sync::OnceLock<Result<crate::gpu::GpuMesh, crate::gpu::GpuError>>,
+    pub(crate) gpu_cache: std::sync::OnceLock<Box<dyn std::any::Any + Send + Sync>>,
 }
 
 impl PreparedScene {
@@ -123,7 +125,7 @@ impl PreparedScene {
             default_near: radius * 1e-3,
             scene,
             #[cfg(feature = "gpu")]
-            gpu_mesh: std::sync::OnceLock::new(),
+            gpu_cache: std::sync::OnceLock::new(),
         }
     }
 
@@ -152,11 +154,18 @@ impl PreparedScene {
     /// Whether triangle `id` is see-through (its material's opacity below 1).
     #[inline(always)]
     pub fn is_transparent(&self, id: u32) -> bool {
-        crate::framebuffer::is_see_through(&self.triangle_opacity, id)
+        is_see_through(&self.triangle_opacity, id)
     }
 
     /// Triangle count, degenerate ones included.
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
     }
+}
+
+/// Whether triangle `id` is see-through under the per-triangle `opacity`
+/// (empty: every triangle opaque).
+#[inline(always)]
+pub(crate) fn is_see_through(opacity: &[f32], id: u32) -> bool {
+    !opacity.is_empty() && opacity[id as usize] < 1.0
 }

@@ -1,6 +1,6 @@
 //! Eight f32 lanes for the per-sample loops, in the instruction set the CPU has.
 //!
-//! The coverage kernels ([`crate::edge::Coverage`]'s 8-lane methods, on 2D,
+//! The coverage kernels (the 8-lane methods of the edge functions' `Coverage`, on 2D,
 //! homogeneous and 3D edge functions) are
 //! written once, generic over [`Lanes`], and compiled twice: on [`Portable`]
 //! (`wide::f32x8`: two SSE halves on x86-64, whatever the target has
@@ -9,15 +9,13 @@
 //! the kernels come in a portable form and an `#[target_feature(enable =
 //! "avx2")]` form. Both perform the same IEEE operations in the same order
 //! with no fused multiply-add (AVX2 does not include FMA, and nothing here asks
-//! for it), so every lane rounds exactly as the scalar [`Coverage::sample`]
+//! for it), so every lane rounds exactly as the scalar `Coverage::sample`
 //! does, on either path.
 //!
 //! Lane code is written in `#[inline(always)]` functions, never in closures:
 //! only what is inlined into the `#[target_feature]` loop is compiled for
 //! AVX2, and an intrinsic left outside it becomes a call per instruction
 //! (`.ci/run` checks the binary for such calls).
-//!
-//! [`Coverage::sample`]: crate::edge::Coverage::sample
 
 use std::ops::{Add, Div, Mul, Sub};
 use std::sync::OnceLock;
@@ -104,7 +102,7 @@ impl sealed::Ops for Portable {
 }
 
 #[cfg(target_arch = "x86_64")]
-pub use avx2_lanes::Avx2;
+pub(crate) use avx2_lanes::Avx2;
 
 #[cfg(target_arch = "x86_64")]
 mod avx2_lanes {

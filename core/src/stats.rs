@@ -3,8 +3,6 @@
 
 use serde::Serialize;
 
-use crate::framebuffer::Framebuffer;
-
 /// Wall time of each stage of one render, in milliseconds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct StageTimes {
@@ -83,7 +81,7 @@ pub struct Stats {
     pub predicted_instructions: u64,
     /// The effects the scene called for and what each cost (empty when it
     /// calls for none).
-    pub effects: Vec<crate::shade::plan::EffectStats>,
+    pub effects: Vec<crate::effects::EffectStats>,
 }
 
 /// Hex xxh3-64 hashes of the result buffers (little-endian bytes), for comparing
@@ -95,41 +93,6 @@ pub struct Hashes {
     /// Every sample's triangle id (with anti-aliasing, the per-pixel sample
     /// digests; without, the same as `triangle_id`).
     pub samples: String,
-}
-
-impl Hashes {
-    /// xxh3 of the buffers' little-endian bytes, hashed in place (no copy of
-    /// the image) and side by side.
-    pub fn of(fb: &Framebuffer) -> Hashes {
-        let hex = |hash: u64| format!("{hash:016x}");
-        let ((triangle_id, color), digest) = rayon::join(
-            || {
-                rayon::join(
-                    || hash_le(&fb.triangle_id, u32::to_le_bytes),
-                    || xxhash_rust::xxh3::xxh3_64(fb.color.as_flattened()),
-                )
-            },
-            || (!fb.sample_digest.is_empty()).then(|| hash_le(&fb.sample_digest, u64::to_le_bytes)),
-        );
-        Hashes {
-            triangle_id: hex(triangle_id),
-            color: hex(color),
-            samples: hex(digest.unwrap_or(triangle_id)),
-        }
-    }
-}
-
-/// xxh3 of `values` as little-endian bytes, streamed through a small buffer.
-fn hash_le<T: Copy, const N: usize>(values: &[T], bytes: fn(T) -> [u8; N]) -> u64 {
-    let mut hasher = xxhash_rust::xxh3::Xxh3::new();
-    let mut buffer = [0u8; 4096];
-    for chunk in values.chunks(buffer.len() / N) {
-        for (out, &v) in buffer.chunks_exact_mut(N).zip(chunk) {
-            out.copy_from_slice(&bytes(v));
-        }
-        hasher.update(&buffer[..chunk.len() * N]);
-    }
-    hasher.digest()
 }
 
 /// Counters of the hierarchical stages (binning, early-z, the BVH traversal).

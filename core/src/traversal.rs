@@ -14,30 +14,16 @@
 
 use glam::{Vec3, Vec3A};
 
-use crate::algorithm::PixelRect;
-use crate::algorithm::screen_boxes::ScreenBoxes;
-use crate::binning::{SampleOracles, raster_triangle};
+use crate::binning::raster_triangle;
 use crate::bvh::{SlabRay, padded};
 use crate::camera::View;
 use crate::edge::Coverage;
 use crate::framebuffer::TileBuffer;
+use crate::ground::PixelRect;
+use crate::pipeline::TraversalOracles;
 use crate::prepared::PreparedScene;
+use crate::screen_boxes::ScreenBoxes;
 use crate::stats::RasterCounters;
-
-/// The oracles of Fig. 7 for a BVH traversal.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct TraversalOracles {
-    /// Side of the initial frusta in pixels (each is one parallel work item).
-    pub frustum: u32,
-    /// `is_outside`: cull nodes outside the frustum.
-    pub outside: bool,
-    /// `is_occluded`: cull nodes behind the hierarchical w-buffer.
-    pub occluded: bool,
-    /// `split_frustum`: split down to this many pixels square (`None`: never).
-    pub split: Option<u32>,
-    /// `generate_samples` at leaves: how samples are enumerated.
-    pub samples: SampleOracles,
-}
 
 /// Sets up a leaf triangle's edge functions for a view (f32 or f64); the
 /// result may borrow both.
@@ -93,8 +79,8 @@ impl Frustum {
         // beyond its outermost samples).
         let kx = |x: u32| (2.0 * x as f32 / v.width as f32 - 1.0) * v.half_x;
         let ky = |y: u32| (1.0 - 2.0 * y as f32 / v.height as f32) * v.half_y;
-        let (left, right_border) = (kx(rect.x0), kx(rect.x1 + 1));
-        let (top, bottom) = (ky(rect.y0), ky(rect.y1 + 1));
+        let (left, right_border) = (kx(rect.x0), kx(rect.x1));
+        let (top, bottom) = (ky(rect.y0), ky(rect.y1));
         let planes = if v.is_orthographic() {
             [
                 (right, left),
@@ -111,8 +97,8 @@ impl Frustum {
             ]
         };
         let (cx, cy) = (
-            (rect.x0 + rect.x1 + 1) as f32 * 0.5,
-            (rect.y0 + rect.y1 + 1) as f32 * 0.5,
+            (rect.x0 + rect.x1) as f32 * 0.5,
+            (rect.y0 + rect.y1) as f32 * 0.5,
         );
         Frustum {
             rect,
@@ -179,7 +165,7 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
             self.counters.nodes_culled_outside += 1;
             return;
         }
-        if self.oracles.occluded && b.min_w > self.tile.hiz_max(f.x0, f.y0, f.x1, f.y1) {
+        if self.oracles.occluded && b.min_w > self.tile.hiz_max(f) {
             self.counters.nodes_culled_occluded += 1;
             return;
         }
@@ -188,34 +174,15 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
             && self.should_split(frustum, &b, min)
         {
             self.counters.frusta_split += 1;
-            let (hx, hy) = ((f.x0 + f.x1) / 2, (f.y0 + f.y1) / 2);
+            // The first halves take the middle pixel of an odd side.
+            let (mx, my) = ((f.x0 + f.x1 + 1) / 2, (f.y0 + f.y1 + 1) / 2);
             for q in [
-                PixelRect {
-                    x0: f.x0,
-                    y0: f.y0,
-                    x1: hx,
-                    y1: hy,
-                },
-                PixelRect {
-                    x0: hx + 1,
-                    y0: f.y0,
-                    x1: f.x1,
-                    y1: hy,
-                },
-                PixelRect {
-                    x0: f.x0,
-                    y0: hy + 1,
-                    x1: hx,
-                    y1: f.y1,
-                },
-                PixelRect {
-                    x0: hx + 1,
-                    y0: hy + 1,
-                    x1: f.x1,
-                    y1: f.y1,
-                },
+                PixelRect::new(f.x0, f.y0, mx, my),
+                PixelRect::new(mx, f.y0, f.x1, my),
+                PixelRect::new(f.x0, my, mx, f.y1),
+                PixelRect::new(mx, my, f.x1, f.y1),
             ] {
-                if q.x0 <= q.x1 && q.y0 <= q.y1 {
+                if !q.is_empty() {
                     self.counters.frusta_created += 1;
                     self.traverse(&Frustum::new(q, self.view), node, b);
                 }
@@ -276,7 +243,7 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
     /// the frustum (paper §5, "3DR frustum split").
     fn should_split(&self, frustum: &Frustum, b: &NodeBox, min: u32) -> bool {
         let f = frustum.rect;
-        let (w, h) = (f.x1 - f.x0 + 1, f.y1 - f.y0 + 1);
+        let (w, h) = (f.width(), f.height());
         if w.max(h) <= min {
             return false;
         }
@@ -324,7 +291,7 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
         }
         if self.oracles.occluded && !self.oracles.samples.early_z {
             // Occlusion culling reads the hierarchical w-buffer: keep it current.
-            self.tile.update_hiz(f.x0, f.y0, f.x1, f.y1);
+            self.tile.update_hiz(f);
         }
     }
 }

@@ -19,8 +19,7 @@ use std::fmt;
 
 use glam::DVec3;
 
-use crate::algorithm::AlgorithmId;
-use crate::request::FieldError;
+use crate::ground::FieldError;
 
 /// How a camera maps pixels to rays.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -92,19 +91,26 @@ impl Viewport {
                 )));
             }
         };
-        v.validate().map_err(|m| bad(format!("'{s}': {m}")))?;
+        v.validate()
+            .map_err(|e| bad(format!("'{s}': {}", e.message)))?;
         Ok(v)
     }
 
     /// Checks the parameter; the message says what is wrong.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), FieldError> {
         match *self {
-            Viewport::Perspective { fov_y_deg } if !(fov_y_deg > 0.0 && fov_y_deg < 180.0) => Err(
-                format!("the field of view must be in (0, 180) degrees, got {fov_y_deg}"),
-            ),
-            Viewport::Orthographic { height } if !(height > 0.0 && height.is_finite()) => Err(
-                format!("the height must be positive and finite, got {height}"),
-            ),
+            Viewport::Perspective { fov_y_deg } if !(fov_y_deg > 0.0 && fov_y_deg < 180.0) => {
+                Err(FieldError::new(
+                    "viewport",
+                    format!("the field of view must be in (0, 180) degrees, got {fov_y_deg}"),
+                ))
+            }
+            Viewport::Orthographic { height } if !(height > 0.0 && height.is_finite()) => {
+                Err(FieldError::new(
+                    "viewport",
+                    format!("the height must be positive and finite, got {height}"),
+                ))
+            }
             _ => Ok(()),
         }
     }
@@ -125,32 +131,6 @@ impl Viewport {
             Viewport::Parabolic => "parabolic",
             Viewport::LatLong => "latlong",
         }
-    }
-
-    /// Can `algorithm` render this viewport? The 2D family and the BVH-frustum
-    /// algorithms need straight edges and planar frusta; the 3D rasterizers
-    /// without frusta and the ray caster evaluate any sample generator.
-    pub fn serves(&self, algorithm: AlgorithmId) -> bool {
-        algorithm.pipeline().serves(self)
-    }
-
-    /// The error for an algorithm this viewport cannot serve, listing what can.
-    pub fn unsupported(&self, algorithm: AlgorithmId) -> FieldError {
-        let served: Vec<&str> = AlgorithmId::ALL
-            .into_iter()
-            .filter(|a| self.serves(*a))
-            .map(AlgorithmId::as_str)
-            .collect();
-        FieldError::new(
-            "viewport",
-            format!(
-                "{algorithm} cannot render the {} viewport (it needs straight edges); \
-                 {} is served by {}; perspective and orthographic by every algorithm",
-                self.kind(),
-                self.kind(),
-                served.join(", ")
-            ),
-        )
     }
 }
 

@@ -15,7 +15,7 @@ fn scenes_dir() -> PathBuf {
 }
 
 fn listing(c: &mut Criterion) {
-    let names = continuum::scene::builtin_names(&scenes_dir());
+    let names = continuum::scene::builtin_names(&scenes_dir()).expect("the scenes folder lists");
     assert!(names.len() >= 12, "built-in scenes: {names:?}");
     let mut group = c.benchmark_group("api_scenes_cold");
     group.sample_size(10);

@@ -4,9 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use continuum::request::{parse_aa, parse_algorithm, parse_size, parse_viewport};
-use continuum::shade::texture::TextureFilter;
-use continuum::{AlgorithmId, Precision, PreparedScene, RenderRequest, maps, render};
+use continuum::{CameraSpec, PreparedScene, RenderWords, maps, render};
 
 use crate::{CliError, scenes_dir, write_stdout};
 
@@ -15,8 +13,8 @@ pub struct RenderArgs {
     /// A built-in scene name, or a .toml, .gltf, .glb or .obj path.
     #[arg(long)]
     scene: String,
-    #[arg(long, help = crate::help::algorithms(), value_parser = |s: &str| parse_algorithm(s).map_err(|e| e.message))]
-    algorithm: AlgorithmId,
+    #[arg(long, help = crate::help::algorithms())]
+    algorithm: String,
     /// A camera of the scene (by name); default: the scene's first camera.
     #[arg(long)]
     camera: Option<String>,
@@ -32,15 +30,15 @@ pub struct RenderArgs {
     aa: String,
     /// Precision of coverage decisions: f32, f64 (3D family) or fixed (2D
     /// family: vertices snapped to 1/256 pixel, exact integer edge functions).
-    #[arg(long, default_value = "f32", value_parser = |s: &str| Precision::parse(s).map_err(|e| e.message))]
-    precision: Precision,
+    #[arg(long, default_value = "f32")]
+    precision: String,
     /// Texture filtering (scenes with textures): nearest, bilinear, trilinear
     /// or anisotropic:N (N in 1..=16).
-    #[arg(long, default_value = "trilinear", value_parser = |s: &str| TextureFilter::parse(s).map_err(|e| e.message))]
-    texture_filter: TextureFilter,
+    #[arg(long, default_value = "trilinear")]
+    texture_filter: String,
     /// Image size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "640x480", value_parser = |s: &str| parse_size(s).map_err(|e| e.message))]
-    size: (u32, u32),
+    #[arg(long, default_value = "640x480")]
+    size: String,
     /// Write the colour image here (PNG).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -58,36 +56,36 @@ pub struct RenderArgs {
     threads: Option<u32>,
 }
 
+impl RenderArgs {
+    /// The flags' words, for the front door every front end shares.
+    fn words(&self) -> RenderWords {
+        RenderWords {
+            scene: self.scene.clone(),
+            algorithm: self.algorithm.clone(),
+            camera: self.camera.clone().map(CameraSpec::Named),
+            oracles: self.oracles.clone(),
+            viewport: self.viewport.clone(),
+            aa: Some(self.aa.clone()),
+            precision: Some(self.precision.clone()),
+            texture_filter: Some(self.texture_filter.clone()),
+            size: Some(self.size.clone()),
+        }
+    }
+}
+
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
-    let aa = parse_aa(&args.aa).map_err(|e| CliError::Usage(format!("--{e}")))?;
+    let usage = |e: continuum::FieldError| CliError::Usage(format!("--{e}"));
+    // Every word checked before the scene is loaded.
+    let settings = args.words().settings().map_err(usage)?;
     let scene =
         continuum::scene::load_named_or_path(&args.scene, &scenes_dir(args.scenes.as_ref()))
             .map_err(|e| CliError::Usage(format!("--scene: {e}")))?;
-    let mut camera = match &args.camera {
-        Some(name) => scene
-            .camera(name)
-            .map_err(|e| CliError::Usage(format!("--camera: {e}")))?,
-        None => scene.first_camera(),
-    };
-    if let Some(text) = &args.viewport {
-        camera.viewport =
-            parse_viewport(text, &camera).map_err(|e| CliError::Usage(format!("--{e}")))?;
-    }
+    let request = settings.request(&scene).map_err(usage)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
     let prepared = PreparedScene::new(scene);
-    let (width, height) = args.size;
-    let request = RenderRequest {
-        algorithm: args.algorithm,
-        oracles: args.oracles.clone(),
-        camera,
-        width,
-        height,
-        aa,
-        precision: args.precision,
-        texture_filter: args.texture_filter,
-    };
+    let (width, height) = (request.width, request.height);
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = args.threads {
         pool = pool.num_threads(t as usize);
@@ -95,7 +93,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let pool = pool.build().context("building the thread pool")?;
     let out = pool
         .install(|| render(&prepared, &request))
-        .map_err(|e| CliError::Usage(format!("--{e}")))?;
+        .map_err(usage)?;
 
     if let Some(path) = &args.out {
         std::fs::write(path, maps::png_bytes(&maps::color_image(&out.framebuffer)))

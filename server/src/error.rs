@@ -3,7 +3,7 @@
 use axum::Json;
 use axum::http::{StatusCode, header};
 use axum::response::{IntoResponse, Response};
-use continuum::request::FieldError;
+use continuum::FieldError;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct ApiError {

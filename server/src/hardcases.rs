@@ -8,7 +8,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use continuum::hardcases::{self, Check, SuiteReport};
+use continuum_hardcases::{self as hardcases, Check, SuiteReport};
 use serde_json::json;
 
 use std::fmt::Write;

@@ -16,7 +16,9 @@ pub fn algorithms_and_peers() -> String {
     format!(
         "Algorithm ids and peers, comma-separated: {}; peers {} (peer-embree and peer-embree-stream need the `embree` feature) [default: every algorithm this machine can run, and the peers built in]",
         AlgorithmId::ALL.map(|a| a.as_str()).join(", "),
-        continuum::peer::PeerId::ALL.map(|p| p.as_str()).join(", ")
+        crate::compare::peer::PeerId::ALL
+            .map(|p| p.as_str())
+            .join(", ")
     )
 }
 

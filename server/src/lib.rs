@@ -9,6 +9,7 @@
 
 mod error;
 mod metrics;
+mod observe;
 mod render_api;
 mod state;
 mod upload;
@@ -38,7 +39,7 @@ pub fn app(state: Arc<AppState>) -> Router {
         .route("/api/algorithms", get(render_api::algorithms))
         .route("/api/render", post(render_api::render_json))
         .route("/api/render.png", get(render_api::render_png))
-        .route("/metrics", get(metrics::metrics))
+        .route("/metrics", get(observe::metrics))
         .fallback(|| async { ApiError::not_found("path", "no such route") })
         .method_not_allowed_fallback(|| async { ApiError::method_not_allowed() })
         .layer(axum::extract::DefaultBodyLimit::max(
@@ -46,7 +47,7 @@ pub fn app(state: Arc<AppState>) -> Router {
         ))
         .layer(axum::middleware::from_fn_with_state(
             state.clone(),
-            metrics::track,
+            observe::track,
         ))
         .with_state(state)
 }

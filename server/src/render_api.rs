@@ -9,11 +9,10 @@ use axum::extract::{Query, State};
 use axum::http::header;
 use axum::response::{IntoResponse, Response};
 use base64::Engine;
-use continuum::request::{
-    CameraSpec, FieldError, parse_aa, parse_algorithm, parse_size, parse_viewport,
+use continuum::{
+    AaMode, AlgorithmId, Bounds, Camera, CameraSpec, FieldError, Precision, RenderOutput,
+    RenderRequest, RenderWords, Settings, Viewport, maps,
 };
-use continuum::shade::texture::TextureFilter;
-use continuum::{AaMode, AlgorithmId, Precision, RenderOutput, RenderRequest, Viewport, maps};
 use serde::Deserialize;
 use serde_json::{Value, json};
 
@@ -39,21 +38,32 @@ pub struct RenderBody {
 /// Image outputs a request may ask for.
 const OUTPUTS: [&str; 4] = ["color", "edge_evals", "depth", "triangle_id"];
 
-/// A body checked against the limits, ready to render.
+impl RenderBody {
+    /// The body's words, for the front door every front end shares.
+    fn words(&self) -> RenderWords {
+        RenderWords {
+            scene: self.scene.clone(),
+            algorithm: self.algorithm.clone(),
+            camera: self.camera.clone(),
+            oracles: self.oracles.clone(),
+            viewport: self.viewport.clone(),
+            aa: self.aa.clone(),
+            precision: self.precision.clone(),
+            texture_filter: self.texture_filter.clone(),
+            size: self.size.clone(),
+        }
+    }
+}
+
+/// A body checked against the limits and the renderer's capabilities, ready
+/// to render once its scene is at hand.
 struct Checked {
     scene: String,
-    algorithm: AlgorithmId,
-    oracles: Option<String>,
-    camera: Option<CameraSpec>,
-    viewport: Option<String>,
-    size: (u32, u32),
-    aa: AaMode,
-    precision: Precision,
-    texture_filter: TextureFilter,
+    settings: Settings,
 }
 
 fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
-    let names = state.scene_names();
+    let names = state.scene_names()?;
     if !names.contains(&body.scene) {
         return Err(ApiError::bad_request(
             "scene",
@@ -64,32 +74,18 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
             ),
         ));
     }
-    let algorithm = parse_algorithm(&body.algorithm)?;
-    let size = parse_size(body.size.as_deref().unwrap_or("640x480"))?;
-    if u64::from(size.0) * u64::from(size.1) > state.limits.max_pixels {
+    let settings = body.words().settings()?;
+    let (width, height, aa) = (settings.width, settings.height, settings.aa);
+    if u64::from(width) * u64::from(height) > state.limits.max_pixels {
         return Err(FieldError::new(
             "size",
             format!(
-                "{}x{} exceeds the limit of {} pixels",
-                size.0, size.1, state.limits.max_pixels
+                "{width}x{height} exceeds the limit of {} pixels",
+                state.limits.max_pixels
             ),
         )
         .into());
     }
-    if let Some(text) = &body.viewport {
-        // The words and the pairing now; bare `orthographic` takes its height
-        // from the camera, resolved when the scene is loaded.
-        let viewport = Viewport::parse(text, Viewport::Orthographic { height: 1.0 })?;
-        if !viewport.serves(algorithm) {
-            return Err(viewport.unsupported(algorithm).into());
-        }
-    }
-    let aa = body
-        .aa
-        .as_deref()
-        .map(parse_aa)
-        .transpose()?
-        .unwrap_or_default();
     let samples_per_pixel = aa.coverage_samples();
     if samples_per_pixel > state.limits.max_samples_per_pixel {
         return Err(FieldError::new(
@@ -101,13 +97,13 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
         )
         .into());
     }
-    let samples = u64::from(size.0) * u64::from(size.1) * u64::from(samples_per_pixel);
+    let samples = u64::from(width) * u64::from(height) * u64::from(samples_per_pixel);
     if samples > state.limits.max_samples {
         return Err(FieldError::new(
             "aa",
             format!(
-                "{}x{} with {aa} is {samples} samples, over the limit of {}; use a smaller size or mode",
-                size.0, size.1, state.limits.max_samples
+                "{width}x{height} with {aa} is {samples} samples, over the limit of {}; use a smaller size or mode",
+                state.limits.max_samples
             ),
         )
         .into());
@@ -126,34 +122,11 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
             ),
         ));
     }
-    if let Some(text) = &body.oracles {
-        algorithm.pipeline().with_oracles(text)?;
-    }
-    let precision = body
-        .precision
-        .as_deref()
-        .map(Precision::parse)
-        .transpose()?
-        .unwrap_or_default();
-    if !precision.serves(algorithm.family()) {
-        return Err(precision.unsupported(algorithm).into());
-    }
-    let texture_filter = body
-        .texture_filter
-        .as_deref()
-        .map(TextureFilter::parse)
-        .transpose()?
-        .unwrap_or_default();
+    // What the renderer would refuse, refused before the render is queued.
+    continuum::check(&settings.probe()?, None)?;
     Ok(Checked {
         scene: body.scene.clone(),
-        algorithm,
-        oracles: body.oracles.clone(),
-        camera: body.camera.clone(),
-        viewport: body.viewport.clone(),
-        size,
-        aa,
-        precision,
-        texture_filter,
+        settings,
     })
 }
 
@@ -179,20 +152,7 @@ async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, 
     let job = tokio::task::spawn_blocking(move || {
         let _permit = permit;
         let prepared = job_state.prepared(&c.scene)?;
-        let mut camera = CameraSpec::resolve(c.camera.as_ref(), &prepared.scene)?;
-        if let Some(text) = &c.viewport {
-            camera.viewport = parse_viewport(text, &camera)?;
-        }
-        let request = RenderRequest {
-            algorithm: c.algorithm,
-            oracles: c.oracles,
-            camera,
-            width: c.size.0,
-            height: c.size.1,
-            aa: c.aa,
-            precision: c.precision,
-            texture_filter: c.texture_filter,
-        };
+        let request = c.settings.request(&prepared.scene)?;
         let out = continuum::render_cancellable(&prepared, &request, &job_cancel)
             .map_err(|e| ApiError::bad_request(e.field, e.to_string()))?;
         job_state
@@ -309,43 +269,17 @@ pub async fn render_png(
 pub async fn scenes(State(state): State<Arc<AppState>>) -> Result<Json<Value>, ApiError> {
     let list = tokio::task::spawn_blocking(move || {
         use rayon::prelude::*;
-        let names = state.scene_names();
-        names
-            .par_iter()
-            .map(|name| (*state.describe(name)).clone())
-            .collect::<Vec<_>>()
+        let names = state.scene_names()?;
+        Ok::<_, ApiError>(
+            names
+                .par_iter()
+                .map(|name| (*state.describe(name)).clone())
+                .collect::<Vec<_>>(),
+        )
     })
     .await
-    .map_err(|e| ApiError::internal(e.to_string()))?;
+    .map_err(|e| ApiError::internal(e.to_string()))??;
     Ok(Json(json!({ "scenes": list })))
-}
-
-/// A scene's catalogue entry.
-pub(crate) fn scene_entry(name: &str, scene: &continuum::Scene, triangles: usize) -> Value {
-    let cameras: Vec<Value> = scene
-        .all_cameras()
-        .iter()
-        .map(|c| {
-            json!({
-                "name": c.name, "eye": c.eye.to_array(), "target": c.target.to_array(),
-                "up": c.up.to_array(), "viewport": c.viewport.to_string(),
-                "fov_y": match c.viewport {
-                    Viewport::Perspective { fov_y_deg } => Some(fov_y_deg),
-                    _ => None,
-                },
-                "near": c.near,
-            })
-        })
-        .collect();
-    json!({
-        "name": name,
-        "triangles": triangles,
-        "cameras": cameras,
-        "lights": scene.lights.len(),
-        // What the scene calls for beyond Lambert shading.
-        "effects": scene.effects(),
-        "warnings": scene.warnings,
-    })
 }
 
 /// `GET /api/algorithms`: every algorithm, what it serves, and whether this
@@ -363,7 +297,15 @@ pub async fn algorithms() -> Result<Json<Value>, ApiError> {
     let list: Vec<Value> = AlgorithmId::ALL
         .iter()
         .zip(unavailable)
-        .map(|(a, why)| {
+        .map(|(&a, why)| {
+            // What the renderer's capability check does not blame `field`
+            // for: one setting varied on an otherwise plain request.
+            let probe = RenderRequest::new(a, Camera::framing(&Bounds::EMPTY), 64, 64);
+            let serves = |field: &str, change: &dyn Fn(&mut RenderRequest)| {
+                let mut request = probe.clone();
+                change(&mut request);
+                continuum::check(&request, None).map_or_else(|e| e.field != field, |_| true)
+            };
             json!({
                 "id": a.as_str(),
                 "available": why.is_none(),
@@ -372,18 +314,18 @@ pub async fn algorithms() -> Result<Json<Value>, ApiError> {
                 "description": a.description(),
                 "viewports": Viewport::KINDS
                     .iter()
-                    .filter(|v| v.serves(*a))
+                    .filter(|v| serves("viewport", &|r| r.camera.viewport = **v))
                     .map(Viewport::kind)
                     .collect::<Vec<_>>(),
-                "takes_oracles": !matches!(a.pipeline(), continuum::Pipeline::Rays | continuum::Pipeline::Gpu),
+                "takes_oracles": serves("oracles", &|r| r.oracles.early_z = Some(false)),
                 "aa": AaMode::all()
                     .iter()
-                    .filter(|m| *a != AlgorithmId::GpuRaster || **m == AaMode::None)
+                    .filter(|m| serves("aa", &|r| r.aa = **m))
                     .map(ToString::to_string)
                     .collect::<Vec<_>>(),
                 "precisions": Precision::ALL
                     .iter()
-                    .filter(|p| p.serves(a.family()))
+                    .filter(|p| serves("precision", &|r| r.precision = **p))
                     .map(|p| p.as_str())
                     .collect::<Vec<_>>(),
             })

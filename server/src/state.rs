@@ -7,7 +7,8 @@ use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use continuum::PreparedScene;
+use continuum::{PreparedScene, Viewport};
+use serde_json::{Value, json};
 use tokio::sync::Semaphore;
 
 use crate::error::ApiError;
@@ -171,8 +172,8 @@ impl AppState {
 
     /// Names of the scenes this service serves: the scenes folder's and the
     /// uploads still cached.
-    pub fn scene_names(&self) -> Vec<String> {
-        let mut names = continuum::scene::builtin_names(&self.scenes_dir);
+    pub fn scene_names(&self) -> Result<Vec<String>, ApiError> {
+        let mut names = self.builtin_names()?;
         if let Ok(cache) = self.cache.lock() {
             let mut uploads: Vec<String> = cache
                 .entries
@@ -183,7 +184,13 @@ impl AppState {
             uploads.sort();
             names.extend(uploads);
         }
-        names
+        Ok(names)
+    }
+
+    /// The scenes folder's scenes; an unreadable folder is the server's error.
+    pub fn builtin_names(&self) -> Result<Vec<String>, ApiError> {
+        continuum::scene::builtin_names(&self.scenes_dir)
+            .map_err(|e| ApiError::internal(format!("listing the scenes: {e}")))
     }
 
     /// The prepared scene `name` (a scene of the scenes folder or an upload,
@@ -193,15 +200,12 @@ impl AppState {
         if let Some(p) = self.cache()?.get(name) {
             return Ok(p);
         }
-        if !continuum::scene::builtin_names(&self.scenes_dir)
-            .iter()
-            .any(|n| n == name)
-        {
+        if !self.builtin_names()?.iter().any(|n| n == name) {
             return Err(ApiError::bad_request(
                 "scene",
                 format!(
                     "unknown scene '{name}'; scenes are: {}",
-                    self.scene_names().join(", ")
+                    self.scene_names()?.join(", ")
                 ),
             ));
         }
@@ -238,11 +242,10 @@ impl AppState {
         }
         let error = |e: String| Arc::new(serde_json::json!({ "name": name, "error": e }));
         // A name, never a path: only the scenes folder's scenes load from disk.
-        if !continuum::scene::builtin_names(&self.scenes_dir)
-            .iter()
-            .any(|n| n == name)
-        {
-            return error(format!("unknown scene '{name}'"));
+        match self.builtin_names() {
+            Ok(names) if names.iter().any(|n| n == name) => {}
+            Ok(_) => return error(format!("unknown scene '{name}'")),
+            Err(e) => return error(e.error),
         }
         match continuum::scene::load_named_or_path(name, &self.scenes_dir) {
             Ok(scene) => {
@@ -260,7 +263,7 @@ impl AppState {
         scene: &continuum::Scene,
         triangles: usize,
     ) -> Arc<serde_json::Value> {
-        let entry = Arc::new(crate::render_api::scene_entry(name, scene, triangles));
+        let entry = Arc::new(scene_entry(name, scene, triangles));
         if let Ok(mut c) = self.catalogue.lock() {
             c.insert(name.to_string(), entry.clone());
         }
@@ -278,4 +281,32 @@ impl AppState {
     pub fn renders_for_test(&self) -> Arc<Semaphore> {
         self.renders.clone()
     }
+}
+
+/// A scene's catalogue entry.
+pub(crate) fn scene_entry(name: &str, scene: &continuum::Scene, triangles: usize) -> Value {
+    let cameras: Vec<Value> = scene
+        .all_cameras()
+        .iter()
+        .map(|c| {
+            json!({
+                "name": c.name, "eye": c.eye.to_array(), "target": c.target.to_array(),
+                "up": c.up.to_array(), "viewport": c.viewport.to_string(),
+                "fov_y": match c.viewport {
+                    Viewport::Perspective { fov_y_deg } => Some(fov_y_deg),
+                    _ => None,
+                },
+                "near": c.near,
+            })
+        })
+        .collect();
+    json!({
+        "name": name,
+        "triangles": triangles,
+        "cameras": cameras,
+        "lights": scene.lights.len(),
+        // What the scene calls for beyond Lambert shading.
+        "effects": scene.effects(),
+        "warnings": scene.warnings,
+    })
 }

@@ -58,7 +58,7 @@ pub async fn upload(
         Some(n) => n,
         None => format!("upload-{:08x}", fnv1a(&body)),
     };
-    if continuum::scene::builtin_names(&state.scenes_dir).contains(&name) {
+    if state.builtin_names()?.contains(&name) {
         return Err(ApiError::bad_request(
             "name",
             format!("'{name}' is a built-in scene"),

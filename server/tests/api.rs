@@ -685,7 +685,8 @@ fn listing_scenes_prepares_none() {
     assert_eq!(status, StatusCode::OK);
     let doc: serde_json::Value = serde_json::from_slice(&body).expect("json");
     let listed = doc["scenes"].as_array().expect("list");
-    let builtin = continuum::scene::builtin_names(&s.state.scenes_dir);
+    let builtin =
+        continuum::scene::builtin_names(&s.state.scenes_dir).expect("the scenes folder lists");
     assert!(builtin.len() >= 12, "{builtin:?}");
     assert_eq!(listed.len(), builtin.len());
     for scene in listed {

@@ -93,7 +93,7 @@ fn render_json_has_the_documented_keys() {
 fn the_avx2_and_portable_kernels_render_the_same_buffers() {
     #[cfg(target_arch = "x86_64")]
     assert!(
-        continuum::simd::cpu_has_avx2(),
+        continuum::internal::cpu_has_avx2(),
         "this test compares the AVX2 kernels with the portable ones, and this CPU has no AVX2"
     );
     let render = |scene: &str, algorithm: &str, aa: &str, simd: &str| {

@@ -1,13 +1,15 @@
 //! Shared helpers for continuum's integration tests: built-in scenes loaded and
 //! prepared once per test process, renders, and buffer comparisons.
 
+pub mod golden;
+pub mod matrix;
 pub mod untrusted;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};
 
-use continuum::{AlgorithmId, Camera, PreparedScene, RenderOutput, RenderRequest, render};
+use continuum::{AlgorithmId, Camera, Oracles, PreparedScene, RenderOutput, RenderRequest, render};
 
 /// The repository's `scenes/` folder.
 pub fn scenes_dir() -> PathBuf {
@@ -16,7 +18,13 @@ pub fn scenes_dir() -> PathBuf {
 
 /// Every built-in scene name.
 pub fn builtin_scenes() -> Vec<String> {
-    continuum::scene::builtin_names(&scenes_dir())
+    let names = continuum::scene::builtin_names(&scenes_dir()).expect("the scenes folder lists");
+    assert!(
+        names.len() >= 12,
+        "only {} built-in scenes: {names:?}",
+        names.len()
+    );
+    names
 }
 
 /// A built-in scene, loaded and prepared once per process.
@@ -59,14 +67,10 @@ pub fn render_with_oracles(
     render(
         scene,
         &RenderRequest {
-            algorithm,
-            oracles: oracles.map(str::to_string),
-            camera: camera.clone(),
-            width,
-            height,
-            aa: continuum::AaMode::None,
-            precision: Default::default(),
-            texture_filter: Default::default(),
+            oracles: oracles
+                .map(|text| Oracles::parse(text).unwrap_or_else(|e| panic!("{text}: {e}")))
+                .unwrap_or_default(),
+            ..RenderRequest::new(algorithm, camera.clone(), width, height)
         },
     )
     .unwrap_or_else(|e| panic!("{algorithm} {oracles:?}: {e}"))
@@ -113,17 +117,23 @@ pub fn render_full(
     render(
         scene,
         &RenderRequest {
-            algorithm,
-            oracles: None,
-            camera: camera.clone(),
-            width,
-            height,
             aa,
             precision,
-            texture_filter: Default::default(),
+            ..RenderRequest::new(algorithm, camera.clone(), width, height)
         },
     )
     .unwrap_or_else(|e| panic!("{algorithm} {aa} {precision}: {e}"))
+}
+
+/// Does `algorithm` serve `viewport`? What the renderer's capability check
+/// does not blame the viewport for.
+pub fn serves(algorithm: AlgorithmId, viewport: continuum::Viewport) -> bool {
+    let camera = Camera {
+        viewport,
+        ..Camera::framing(&continuum::Bounds::EMPTY)
+    };
+    continuum::check(&RenderRequest::new(algorithm, camera, 8, 8), None)
+        .map_or_else(|e| e.field != "viewport", |_| true)
 }
 
 /// Pixels where two triangle-id buffers differ, as `(x, y, a, b)`.

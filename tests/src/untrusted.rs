@@ -2,7 +2,7 @@
 //! `loaders::untrusted` feed it: any bytes must load or fail with an error,
 //! never panic or hang; what loads must prepare and render.
 
-use continuum::{AaMode, AlgorithmId, PreparedScene, RenderRequest, render};
+use continuum::{AlgorithmId, PreparedScene, RenderRequest, render};
 
 /// Which loader reads the bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -41,16 +41,7 @@ pub fn exercise(format: Format, data: &[u8]) -> Result<(), String> {
         AlgorithmId::ThreeDBin,
         AlgorithmId::Raycast,
     ] {
-        let request = RenderRequest {
-            algorithm,
-            oracles: None,
-            camera: camera.clone(),
-            width: 16,
-            height: 16,
-            aa: AaMode::None,
-            precision: Default::default(),
-            texture_filter: Default::default(),
-        };
+        let request = RenderRequest::new(algorithm, camera.clone(), 16, 16);
         // A camera the scene names may not serve every algorithm (a
         // non-planar viewport with a 2D one): an error, not a crash.
         let _ = render(&prepared, &request);

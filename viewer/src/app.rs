@@ -7,15 +7,17 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, PoisonError};
 
-use continuum::shade::texture::TextureFilter;
+use continuum::TextureFilter;
 use continuum::{AaMode, AlgorithmId, Precision, RenderOutput, Stats, Viewport};
 use eframe::egui::{self, Color32, ColorImage, TextureHandle, TextureOptions};
 
-use crate::config::{CameraChoice, Config, ConfigError, Method, SceneSource, has_scene_extension};
+use continuum::FieldError;
+
+use crate::config::{CameraChoice, Config, Method, SceneSource, has_scene_extension};
 use crate::image_view::{self, Gesture};
 use crate::images::{self, Difference, ViewKind};
 use crate::orbit;
-use crate::timings::{self, History};
+use crate::timings::{self, History, Row};
 use crate::worker::{Activity, Job, Outcome, RenderWorker};
 
 /// The resolutions offered beside the width and height fields.
@@ -104,7 +106,7 @@ pub struct ViewerApp {
     submitted: Option<Job>,
     shown: Option<Shown>,
     /// Why the newest job failed (the last good image stays on screen).
-    error: Option<ConfigError>,
+    error: Option<FieldError>,
     history: History,
     scene_path: String,
     /// A scenes folder the user opened: its scene and model files.
@@ -130,7 +132,7 @@ impl ViewerApp {
         let wake = ctx.clone();
         ViewerApp {
             worker: RenderWorker::start(scenes_dir.to_owned(), move || wake.request_repaint()),
-            builtins: continuum::scene::builtin_names(scenes_dir),
+            builtins: continuum::scene::builtin_names(scenes_dir).unwrap_or_default(),
             config,
             compare: None,
             view: ViewKind::Color,
@@ -180,7 +182,7 @@ impl ViewerApp {
     }
 
     /// The error of the newest job, if it failed.
-    pub fn error(&self) -> Option<&ConfigError> {
+    pub fn error(&self) -> Option<&FieldError> {
         self.error.as_ref()
     }
 
@@ -745,7 +747,7 @@ fn method_controls(ui: &mut egui::Ui, id: &str, method: &mut Method) {
 }
 
 fn size_controls(ui: &mut egui::Ui, config: &mut Config) {
-    let max = continuum::render::MAX_DIMENSION;
+    let max = continuum::MAX_DIMENSION;
     ui.horizontal(|ui| {
         let width = ui.label("size");
         ui.add(egui::DragValue::new(&mut config.width).range(1..=max))
@@ -815,9 +817,6 @@ fn pixel_table(ui: &mut egui::Ui, shown: &Shown, (x, y): (u32, u32)) {
             }
         });
 }
-
-/// A table row: its name and how to read its value.
-pub(crate) type Row<T, V> = (&'static str, fn(&T) -> V);
 
 /// The label of a render in the history: its algorithm, with any method
 /// setting that is not the default.

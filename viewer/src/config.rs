@@ -5,9 +5,10 @@
 
 use std::path::{Path, PathBuf};
 
-use continuum::request::{parse_aa, parse_algorithm, parse_size, parse_viewport};
-use continuum::shade::texture::TextureFilter;
-use continuum::{AaMode, AlgorithmId, Camera, Precision, RenderRequest, Scene};
+use continuum::{
+    AaMode, AlgorithmId, Camera, CameraSpec, FieldError, Oracles, Precision, PreparedScene,
+    RenderRequest, RenderWords, Scene, Settings, TextureFilter,
+};
 
 /// Whether `path` names a scene file or a model the loaders read.
 pub fn has_scene_extension(path: &Path) -> bool {
@@ -119,81 +120,88 @@ impl Default for Config {
     }
 }
 
-/// A configuration value that cannot be used, naming its field.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("{field}: {message}")]
-pub struct ConfigError {
-    pub field: &'static str,
-    pub message: String,
-}
-
-impl From<continuum::request::FieldError> for ConfigError {
-    fn from(e: continuum::request::FieldError) -> ConfigError {
-        ConfigError {
-            field: e.field,
-            message: e.message,
-        }
-    }
-}
-
 impl Config {
-    /// The configuration the command line describes (the `render` flags' words).
-    pub fn from_words(
-        scene: &str,
-        camera: Option<&str>,
-        algorithm: &str,
-        viewport: Option<&str>,
-        aa: &str,
-        precision: &str,
-        size: &str,
-    ) -> Result<Config, ConfigError> {
-        let (width, height) = parse_size(size)?;
+    /// The configuration the command line describes (the `render` flags'
+    /// words, through the front door every front end shares).
+    pub fn from_words(words: &RenderWords) -> Result<Config, FieldError> {
+        let settings = words.settings()?;
+        let camera = match &settings.camera {
+            None => None,
+            Some(CameraSpec::Named(name)) => Some(name.clone()),
+            Some(CameraSpec::Explicit(_)) => {
+                return Err(FieldError::new(
+                    "camera",
+                    "the viewer takes a camera's name",
+                ));
+            }
+        };
         Ok(Config {
-            scene: SceneSource::parse(scene),
-            camera: CameraChoice::Named(camera.map(str::to_owned)),
-            viewport: viewport.unwrap_or_default().to_owned(),
+            scene: SceneSource::parse(&words.scene),
+            camera: CameraChoice::Named(camera),
+            viewport: settings.viewport.clone().unwrap_or_default(),
             method: Method {
-                algorithm: parse_algorithm(algorithm)?,
-                oracles: String::new(),
-                aa: parse_aa(aa)?,
-                precision: Precision::parse(precision)?,
-                texture_filter: TextureFilter::default(),
+                algorithm: settings.algorithm,
+                oracles: settings.oracles.to_string(),
+                aa: settings.aa,
+                precision: settings.precision,
+                texture_filter: settings.texture_filter,
             },
-            width,
-            height,
+            width: settings.width,
+            height: settings.height,
             ..Config::default()
         })
     }
 
     /// The camera this configuration looks through in `scene`, viewport applied.
-    pub fn camera_in(&self, scene: &Scene) -> Result<Camera, ConfigError> {
-        let mut camera = match &self.camera {
-            CameraChoice::Named(None) => scene.first_camera(),
-            CameraChoice::Named(Some(name)) => scene.camera(name).map_err(|e| ConfigError {
-                field: "camera",
-                message: e.to_string(),
-            })?,
-            CameraChoice::Moved(camera) => camera.clone(),
-        };
-        if !self.viewport.trim().is_empty() {
-            camera.viewport = parse_viewport(self.viewport.trim(), &camera)?;
-        }
-        Ok(camera)
+    pub fn camera_in(&self, scene: &Scene) -> Result<Camera, FieldError> {
+        Ok(self
+            .settings(&self.method)?
+            .request_through(self.base_camera(scene)?)?
+            .camera)
     }
 
-    /// The core request for `method` in `scene` (the compare view's B uses its own method).
-    pub fn request(&self, scene: &Scene, method: &Method) -> Result<RenderRequest, ConfigError> {
+    /// The camera before the viewport words: the scene's, or the one the user moved.
+    fn base_camera(&self, scene: &Scene) -> Result<Camera, FieldError> {
+        match &self.camera {
+            CameraChoice::Named(name) => {
+                let spec = name.clone().map(CameraSpec::Named);
+                CameraSpec::resolve(spec.as_ref(), scene)
+            }
+            CameraChoice::Moved(camera) => Ok(camera.clone()),
+        }
+    }
+
+    /// The settings `method` renders this configuration with, through the
+    /// front door every front end shares.
+    fn settings(&self, method: &Method) -> Result<Settings, FieldError> {
         let oracles = method.oracles.trim();
-        Ok(RenderRequest {
-            algorithm: method.algorithm,
-            oracles: (!oracles.is_empty()).then(|| oracles.to_owned()),
-            camera: self.camera_in(scene)?,
-            width: self.width,
-            height: self.height,
+        let viewport = self.viewport.trim();
+        Ok(Settings {
+            oracles: if oracles.is_empty() {
+                Oracles::default()
+            } else {
+                Oracles::parse(oracles)?
+            },
+            viewport: (!viewport.is_empty()).then(|| viewport.to_owned()),
             aa: method.aa,
             precision: method.precision,
             texture_filter: method.texture_filter,
+            ..Settings::new(method.algorithm, self.width, self.height)
         })
+    }
+
+    /// The core request for `method` in `scene` (the compare view's B uses
+    /// its own method), checked by the renderer's capability check.
+    pub fn request(
+        &self,
+        scene: &PreparedScene,
+        method: &Method,
+    ) -> Result<RenderRequest, FieldError> {
+        let request = self
+            .settings(method)?
+            .request_through(self.base_camera(&scene.scene)?)?;
+        continuum::check(&request, Some(scene))?;
+        Ok(request)
     }
 }
 
@@ -219,32 +227,21 @@ mod tests {
 
     #[test]
     fn bad_words_name_their_field() {
-        let err = |r: Result<Config, ConfigError>| r.expect_err("must be refused").field;
-        let ok = ("bunny", None, "raycast", None, "none", "f32", "64x48");
-        assert!(Config::from_words(ok.0, ok.1, ok.2, ok.3, ok.4, ok.5, ok.6).is_ok());
-        assert_eq!(
-            err(Config::from_words(
-                "bunny", None, "4dr", None, "none", "f32", "64x48"
-            )),
-            "algorithm"
-        );
-        assert_eq!(
-            err(Config::from_words(
-                "bunny", None, "raycast", None, "msaa:3", "f32", "64x48"
-            )),
-            "aa"
-        );
-        assert_eq!(
-            err(Config::from_words(
-                "bunny", None, "raycast", None, "none", "f16", "64x48"
-            )),
-            "precision"
-        );
-        assert_eq!(
-            err(Config::from_words(
-                "bunny", None, "raycast", None, "none", "f32", "0x48"
-            )),
-            "size"
-        );
+        let words = |algorithm: &str, aa: &str, precision: &str, size: &str| RenderWords {
+            scene: "bunny".into(),
+            aa: Some(aa.into()),
+            precision: Some(precision.into()),
+            size: Some(size.into()),
+            ..RenderWords::new(algorithm)
+        };
+        let err = |w: RenderWords| Config::from_words(&w).expect_err("must be refused").field;
+        assert!(Config::from_words(&words("raycast", "none", "f32", "64x48")).is_ok());
+        assert_eq!(err(words("4dr", "none", "f32", "64x48")), "algorithm");
+        assert_eq!(err(words("raycast", "msaa:3", "f32", "64x48")), "aa");
+        assert_eq!(err(words("raycast", "none", "f16", "64x48")), "precision");
+        assert_eq!(err(words("raycast", "none", "f32", "0x48")), "size");
+        let mut w = words("3dr-full", "none", "f32", "64x48");
+        w.oracles = Some("split=3".into());
+        assert_eq!(err(w), "oracles");
     }
 }

@@ -12,4 +12,4 @@ pub mod timings;
 pub mod worker;
 
 pub use app::ViewerApp;
-pub use config::{Config, ConfigError, Method, SceneSource};
+pub use config::{Config, Method, SceneSource};

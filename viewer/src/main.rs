@@ -76,23 +76,21 @@ fn main() -> ExitCode {
         eprintln!("error: {message}");
         ExitCode::from(2)
     };
-    let mut config = match Config::from_words(
-        &args.scene,
-        args.camera.as_deref(),
-        &args.algorithm,
-        args.viewport.as_deref(),
-        &args.aa,
-        &args.precision,
-        &args.size,
-    ) {
+    let words = continuum::RenderWords {
+        scene: args.scene.clone(),
+        algorithm: args.algorithm.clone(),
+        camera: args.camera.clone().map(continuum::CameraSpec::Named),
+        oracles: args.oracles.clone(),
+        viewport: args.viewport.clone(),
+        aa: Some(args.aa.clone()),
+        precision: Some(args.precision.clone()),
+        texture_filter: Some(args.texture_filter.clone()),
+        size: Some(args.size.clone()),
+    };
+    let mut config = match Config::from_words(&words) {
         Ok(c) => c,
         Err(e) => return usage(format!("--{e}")),
     };
-    config.method.oracles = args.oracles.clone().unwrap_or_default();
-    match continuum::shade::texture::TextureFilter::parse(&args.texture_filter) {
-        Ok(f) => config.method.texture_filter = f,
-        Err(e) => return usage(format!("--{e}")),
-    }
     if let Some(t) = args.threads {
         if t == 0 {
             return usage("--threads: must be at least 1".into());
@@ -103,7 +101,7 @@ fn main() -> ExitCode {
         Ok(v) => v,
         Err(e) => return usage(format!("--view: {e}")),
     };
-    let window = match continuum::request::parse_size(&args.window) {
+    let window = match continuum::parse_size(&args.window) {
         Ok((w, h)) => [w as f32, h as f32],
         Err(e) => return usage(format!("--window: {}", e.message)),
     };

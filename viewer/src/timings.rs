@@ -162,7 +162,7 @@ pub fn history_plot(ui: &mut egui::Ui, history: &History) {
 
 /// The counters of each labelled render, one column per render.
 pub fn counters_table(ui: &mut egui::Ui, renders: &[(&str, &Stats)]) {
-    let rows: [crate::app::Row<Stats, u64>; 16] = [
+    let rows: [Row<Stats, u64>; 16] = [
         ("triangle setups", |s| s.triangle_setups),
         ("edge evaluations", |s| s.edge_evaluations),
         ("max per pixel", |s| u64::from(s.max_edge_evals_per_pixel)),
@@ -248,6 +248,9 @@ pub fn thousands(n: u64) -> String {
     }
     out
 }
+
+/// A table row: its name and how to read its value.
+pub(crate) type Row<T, V> = (&'static str, fn(&T) -> V);
 
 #[cfg(test)]
 mod tests {

@@ -12,7 +12,9 @@ use std::time::{Duration, Instant};
 
 use continuum::{Camera, PreparedScene, RenderOutput, render};
 
-use crate::config::{Config, ConfigError, Method, SceneSource};
+use continuum::FieldError;
+
+use crate::config::{Config, Method, SceneSource};
 
 /// What the UI asks for: a configuration, and optionally a second method to
 /// render beside it (the compare view's B).
@@ -27,7 +29,7 @@ pub struct Job {
 pub struct Outcome {
     pub generation: u64,
     pub job: Job,
-    pub result: Result<Rendered, ConfigError>,
+    pub result: Result<Rendered, FieldError>,
     /// Wall time of the whole job, scene loading included.
     pub wall: Duration,
 }
@@ -40,7 +42,7 @@ pub struct Rendered {
     pub camera: Camera,
     pub a: RenderOutput,
     /// The compare view's B, or why it could not be rendered.
-    pub b: Option<Result<RenderOutput, ConfigError>>,
+    pub b: Option<Result<RenderOutput, FieldError>>,
 }
 
 /// What the worker is doing, for the UI's spinner.
@@ -212,7 +214,7 @@ fn run_job(
     pools: &mut HashMap<usize, rayon::ThreadPool>,
     scenes_dir: &Path,
     rendering: impl FnOnce(),
-) -> Result<Rendered, ConfigError> {
+) -> Result<Rendered, FieldError> {
     let config = &job.config;
     let scene = scenes.get(&config.scene, scenes_dir)?;
     rendering();
@@ -223,19 +225,15 @@ fn run_job(
             rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
-                .map_err(|e| ConfigError {
+                .map_err(|e| FieldError {
                     field: "threads",
                     message: format!("cannot start {threads} render threads: {e}"),
                 })?,
         ),
     };
-    let render_method = |method: &Method| -> Result<RenderOutput, ConfigError> {
-        let request = config.request(&scene.scene, method)?;
+    let render_method = |method: &Method| -> Result<RenderOutput, FieldError> {
+        let request = config.request(&scene, method)?;
         pool.install(|| render(&scene, &request))
-            .map_err(|e| ConfigError {
-                field: e.field,
-                message: e.message,
-            })
     };
     let a = render_method(&config.method)?;
     let b = job.compare.as_ref().map(render_method);
@@ -261,7 +259,7 @@ impl SceneCache {
         &mut self,
         source: &SceneSource,
         scenes_dir: &Path,
-    ) -> Result<Arc<PreparedScene>, ConfigError> {
+    ) -> Result<Arc<PreparedScene>, FieldError> {
         if let Some(i) = self.entries.iter().position(|(s, _)| s == source) {
             let entry = self.entries.remove(i);
             let scene = Arc::clone(&entry.1);
@@ -270,7 +268,7 @@ impl SceneCache {
         }
         let scene =
             continuum::scene::load_named_or_path(&source.as_arg(), scenes_dir).map_err(|e| {
-                ConfigError {
+                FieldError {
                     field: "scene",
                     message: e.to_string(),
                 }
@@ -291,8 +289,12 @@ mod tests {
 
     fn job(algorithm: &str, size: &str) -> Job {
         Job {
-            config: Config::from_words("bunny", None, algorithm, None, "none", "f32", size)
-                .expect("valid words"),
+            config: Config::from_words(&continuum::RenderWords {
+                scene: "bunny".into(),
+                size: Some(size.into()),
+                ..continuum::RenderWords::new(algorithm)
+            })
+            .expect("valid words"),
             compare: None,
         }
     }

@@ -19,8 +19,12 @@ use egui_kittest::kittest::{NodeT as _, Queryable as _};
 const WINDOW: egui::Vec2 = egui::vec2(1280.0, 800.0);
 
 fn config(algorithm: &str) -> Config {
-    let mut c = Config::from_words("bunny", None, algorithm, None, "none", "f32", "320x240")
-        .expect("valid words");
+    let mut c = Config::from_words(&continuum::RenderWords {
+        scene: "bunny".into(),
+        size: Some("320x240".into()),
+        ..continuum::RenderWords::new(algorithm)
+    })
+    .expect("valid words");
     c.threads = 2;
     c
 }
@@ -143,7 +147,7 @@ fn compare_view_counts_differing_pixels() {
             .expect("bunny loads");
     let prepared = PreparedScene::new(scene);
     let ids = |m: &Method| {
-        let request = a.request(&prepared.scene, m).expect("a valid request");
+        let request = a.request(&prepared, m).expect("a valid request");
         render(&prepared, &request)
             .expect("renders")
             .framebuffer

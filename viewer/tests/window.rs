@@ -68,16 +68,12 @@ fn reference() -> image::RgbaImage {
         continuum::scene::load_named_or_path("teapots", &continuum::scene::default_scenes_dir())
             .expect("teapots loads");
     let prepared = PreparedScene::new(scene);
-    let request = RenderRequest {
-        algorithm: AlgorithmId::ThreeDBrute,
-        oracles: None,
-        camera: prepared.scene.first_camera(),
-        width: SIZE.0,
-        height: SIZE.1,
-        aa: Default::default(),
-        precision: Default::default(),
-        texture_filter: Default::default(),
-    };
+    let request = RenderRequest::new(
+        AlgorithmId::ThreeDBrute,
+        prepared.scene.first_camera(),
+        SIZE.0,
+        SIZE.1,
+    );
     maps::color_image(&render(&prepared, &request).expect("renders").framebuffer)
 }
 

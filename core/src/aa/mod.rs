@@ -17,13 +17,12 @@
 //! (module `resolve`) is a box filter over the coverage samples in linear light.
 
 mod pattern;
-pub(crate) mod resolve;
 
 use std::fmt;
 
-pub use pattern::{SamplePattern, SampleSpan};
+pub use pattern::SamplePattern;
 
-use crate::request::FieldError;
+use crate::ground::FieldError;
 
 /// How many samples a pixel gets and how they are shaded.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -52,7 +51,9 @@ pub const CSAA_STORED: [u32; 4] = [1, 2, 4, 8];
 
 /// The reference every mode's accuracy is measured against: 16×16 stratified
 /// samples, each shaded.
-pub const REFERENCE: AaMode = AaMode::Ssaa(256);
+impl AaMode {
+    pub const REFERENCE: AaMode = AaMode::Ssaa(256);
+}
 
 impl AaMode {
     /// Parses the CLI's words: `none`, `ssaa:N`, `msaa:N`, `csaa:CxS`.

@@ -16,6 +16,7 @@
 //! an axis-aligned edge differs from the covered area by at most 1/N.
 
 use super::AaMode;
+use crate::ground::SampleSpan;
 
 /// Direct3D 11 / Vulkan standard sample locations, in 1/16 pixel from the
 /// pixel centre (`y` down).
@@ -69,14 +70,6 @@ pub struct SamplePattern {
     /// CSAA: per coverage position, the stored positions nearest first
     /// (empty when every position is stored).
     pub nearest: Vec<Vec<u8>>,
-}
-
-/// The box of sample offsets inside a pixel: a sample of pixel `p` lies in
-/// `[p + lo, p + hi]` per axis.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SampleSpan {
-    pub lo: [f32; 2],
-    pub hi: [f32; 2],
 }
 
 impl SamplePattern {

@@ -14,10 +14,9 @@ use crate::aa::SamplePattern;
 use crate::bvh::{PACKET, PacketRays};
 use crate::camera::View;
 use crate::edge::Coverage;
-use crate::framebuffer::{
-    BACKGROUND, Fragment, Framebuffer, TileBuffer, is_see_through, wins_depth_test,
-};
+use crate::framebuffer::{BACKGROUND, Fragment, Framebuffer, TileBuffer, wins_depth_test};
 use crate::prepared::PreparedScene;
+use crate::prepared::is_see_through;
 use crate::simd::{self, Lanes};
 use crate::stats::Stats;
 
@@ -68,7 +67,7 @@ pub(crate) fn render_raycast<'a, T: Coverage + Send + Sync>(
         .map_init(
             || None,
             |cache, (y0, y1)| {
-                context.run_tile(cache, (0, y0, width, y1), |tile| {
+                context.run_tile(cache, PixelRect::new(0, y0, width, y1), |tile| {
                     cast_band(scene, view, &setups, tile)
                 })
             },
@@ -380,11 +379,11 @@ fn block_mask(rect: PixelRect, x: u32, y: u32) -> u16 {
     mask
 }
 
-/// Bits `i < BLOCK` with `from + i` in `lo..=hi`.
+/// Bits `i < BLOCK` with `from + i` in `lo..hi`.
 #[inline(always)]
 fn span_bits(lo: u32, hi: u32, from: u32) -> u16 {
     let start = lo.saturating_sub(from).min(BLOCK);
-    let end = (hi + 1).saturating_sub(from).min(BLOCK);
+    let end = hi.saturating_sub(from).min(BLOCK);
     if start >= end {
         return 0;
     }
@@ -435,17 +434,12 @@ mod tests {
         let mut rng = fastrand::Rng::with_seed(3);
         for _ in 0..20_000 {
             let (x0, y0) = (rng.u32(0..24), rng.u32(0..24));
-            let rect = PixelRect {
-                x0,
-                y0,
-                x1: x0 + rng.u32(0..8),
-                y1: y0 + rng.u32(0..8),
-            };
+            let rect = PixelRect::new(x0, y0, x0 + rng.u32(0..9), y0 + rng.u32(0..9));
             let (x, y) = (rng.u32(0..32), rng.u32(0..32));
             let mask = block_mask(rect, x, y);
             for l in 0..PACKET as u32 {
                 let (px, py) = (x + l % BLOCK, y + l / BLOCK);
-                let inside = (rect.x0..=rect.x1).contains(&px) && (rect.y0..=rect.y1).contains(&py);
+                let inside = rect.contains(px, py);
                 assert_eq!(
                     mask >> l & 1 == 1,
                     inside,

@@ -7,14 +7,14 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::PixelRect;
 use super::tiles::Placed;
-use crate::aa::SampleSpan;
 use crate::camera::View;
 use crate::clip::{
     ClipPlane, GUARD_BAND, MAX_CLIPPED, clip_triangle, fixed_guard_band, pipeline_planes,
 };
 use crate::edge::{ScreenVertex, Triangle2D, Triangle2DFixed};
+use crate::ground::PixelRect;
+use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
 
 /// Every drawable triangle, clipped, projected and set up with f32 edge

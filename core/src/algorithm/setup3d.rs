@@ -5,16 +5,16 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::PixelRect;
-use super::screen_boxes::ScreenBoxes;
 use super::tiles::Placed;
-use crate::aa::SampleSpan;
 use crate::camera::View;
 use crate::edge::{
     CurvedTriangle, EightTriangles, HomogeneousVertex, Triangle3D, Triangle3D64,
     setup_homogeneous_from,
 };
+use crate::ground::PixelRect;
+use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
+use crate::screen_boxes::ScreenBoxes;
 
 /// Every drawable triangle with samples on screen, set up with 3D edge functions.
 pub(crate) fn setup_3d<'a>(

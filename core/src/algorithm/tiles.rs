@@ -5,9 +5,10 @@
 use rayon::prelude::*;
 
 use super::{Pass, PixelRect, TileContext};
-use crate::binning::{SampleOracles, raster_triangle};
+use crate::binning::raster_triangle;
 use crate::edge::Coverage;
 use crate::framebuffer::Framebuffer;
+use crate::pipeline::SampleOracles;
 use crate::stats::RasterCounters;
 
 /// Side of a screen tile in pixels.
@@ -33,8 +34,8 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
     let rows = fb.height.div_ceil(TILE) as usize;
     let tile_count = columns * rows;
     let tiles_of = |r: &PixelRect| {
-        let (tx0, tx1) = (r.x0 / TILE, r.x1 / TILE);
-        let (ty0, ty1) = (r.y0 / TILE, r.y1 / TILE);
+        let (tx0, tx1) = (r.x0 / TILE, (r.x1 - 1) / TILE);
+        let (ty0, ty1) = (r.y0 / TILE, (r.y1 - 1) / TILE);
         (ty0..=ty1)
             .flat_map(move |ty| (tx0..=tx1).map(move |tx| ty as usize * columns + tx as usize))
     };

@@ -399,7 +399,7 @@ impl ExactEdges<'_> {
         let view = self.view;
         self.vertices.map(|p| {
             let v = match self.form {
-                ExactForm::Homogeneous => super::homogeneous::homogeneous_point(p, view),
+                ExactForm::Homogeneous => homogeneous_point(p, view),
                 _ => p - view.eye,
             };
             v.as_dvec3().to_array()
@@ -660,6 +660,37 @@ impl Coverage for Triangle3D<'_> {
 
     fn min_depth(&self) -> f32 {
         self.w_range[0].max(self.near)
+    }
+}
+
+/// A vertex in homogeneous pixel coordinates `(X, Y, W)`, `x = X/W`
+/// (orthographic: `W = 1`).
+pub(crate) fn homogeneous_point(p: Vec3, view: &View) -> Vec3 {
+    HomogeneousVertex::of(p, view).h
+}
+
+/// A vertex transformed for the homogeneous setup: its homogeneous pixel
+/// coordinates ([`homogeneous_point`]) and its view-axis distance `w`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct HomogeneousVertex {
+    pub(super) h: Vec3,
+    pub(super) w: f32,
+}
+
+impl HomogeneousVertex {
+    #[inline]
+    pub(crate) fn of(p: Vec3, view: &View) -> HomogeneousVertex {
+        let (half_w, half_h) = (view.width as f32 * 0.5, view.height as f32 * 0.5);
+        let c = view.to_camera(p);
+        let w = if view.is_orthographic() { 1.0 } else { c.z };
+        HomogeneousVertex {
+            h: Vec3::new(
+                (c.x / view.half_x + w) * half_w,
+                (w - c.y / view.half_y) * half_h,
+                w,
+            ),
+            w: c.z,
+        }
     }
 }
 

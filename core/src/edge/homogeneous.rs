@@ -12,50 +12,17 @@
 use glam::Vec3;
 
 use super::Triangle3D;
-use super::edge3d::{EPS, ExactEdges, ExactForm, abs_cross, image_extent, orientation, scaled};
+use super::edge3d::{
+    EPS, ExactEdges, ExactForm, HomogeneousVertex, abs_cross, image_extent, orientation, scaled,
+};
 use super::exact;
 use crate::camera::View;
 
-/// A vertex in homogeneous pixel coordinates `(X, Y, W)`, `x = X/W`
-/// (orthographic: `W = 1`).
-pub(crate) fn homogeneous_point(p: Vec3, view: &View) -> Vec3 {
-    HomogeneousVertex::of(p, view).h
-}
-
-/// A vertex transformed for the homogeneous setup: its homogeneous pixel
-/// coordinates ([`homogeneous_point`]) and its view-axis distance `w`.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct HomogeneousVertex {
-    h: Vec3,
-    w: f32,
-}
-
-impl HomogeneousVertex {
-    #[inline]
-    pub(crate) fn of(p: Vec3, view: &View) -> HomogeneousVertex {
-        let (half_w, half_h) = (view.width as f32 * 0.5, view.height as f32 * 0.5);
-        let c = view.to_camera(p);
-        let w = if view.is_orthographic() { 1.0 } else { c.z };
-        HomogeneousVertex {
-            h: Vec3::new(
-                (c.x / view.half_x + w) * half_w,
-                (w - c.y / view.half_y) * half_h,
-                w,
-            ),
-            w: c.z,
-        }
-    }
-}
-
-/// Setup of Fig. 10 (middle): transform, three cross products, determinant.
-/// `None` when the determinant is zero (degenerate or seen edge-on).
-/// Orthographic views have `W = 1` at every vertex, and `w` is interpolated
-/// linearly: `w = Σ w_i·E_i / ΣE_i`.
-pub fn setup_homogeneous<'a>(p: &'a [Vec3; 3], view: &'a View) -> Option<Triangle3D<'a>> {
-    setup_homogeneous_from(p, p.map(|v| HomogeneousVertex::of(v, view)), view)
-}
-
-/// [`setup_homogeneous`] of the triangle `p` from its vertices, transformed.
+/// Setup of Fig. 10 (middle) of the triangle `p` from its vertices,
+/// transformed (once per render, shared by the triangles that meet there):
+/// three cross products and the determinant. `None` when the determinant is
+/// zero (degenerate or seen edge-on). Orthographic views have `W = 1` at
+/// every vertex, and `w` is interpolated linearly: `w = Σ w_i·E_i / ΣE_i`.
 pub(crate) fn setup_homogeneous_from<'a>(
     p: &'a [Vec3; 3],
     vertices: [HomogeneousVertex; 3],

@@ -25,10 +25,10 @@ pub use curved::CurvedTriangle;
 pub use edge2d::{ScreenVertex, Triangle2D};
 pub use edge2d_fixed::Triangle2DFixed;
 pub(crate) use edge3d::EPS;
+pub(crate) use edge3d::HomogeneousVertex;
 pub use edge3d::Triangle3D;
 pub use edge3d_f64::Triangle3D64;
-pub use homogeneous::setup_homogeneous;
-pub(crate) use homogeneous::{HomogeneousVertex, setup_homogeneous_from};
+pub(crate) use homogeneous::setup_homogeneous_from;
 
 thread_local! {
     /// This thread's running count of 3D (and homogeneous) edge tests the f32 sign could not

@@ -18,10 +18,11 @@
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
-use crate::aa::resolve::resolve_tile;
 use crate::camera::View;
 use crate::framebuffer::{Framebuffer, TileBuffer};
+use crate::ground::PixelRect;
 use crate::prepared::PreparedScene;
+use crate::resolve::resolve_tile;
 use crate::shade::Shader;
 use crate::stats::Stats;
 
@@ -501,8 +502,10 @@ pub(crate) fn render_gpu_raster(
     // 1. Setup: the scene's vertices on the device (once per prepared scene).
     let start = Instant::now();
     let mesh = scene
-        .gpu_mesh
-        .get_or_init(|| gpu.upload(scene))
+        .gpu_cache
+        .get_or_init(|| Box::new(gpu.upload(scene)))
+        .downcast_ref::<Result<GpuMesh, GpuError>>()
+        .ok_or_else(|| GpuError::Failed("the scene's GPU cache holds another type".into()))?
         .as_ref()
         .map_err(Clone::clone)?;
     stats.triangle_setups = scene.drawable.len() as u64;
@@ -515,7 +518,7 @@ pub(crate) fn render_gpu_raster(
     // 3. Resolve and shade on the CPU, as every algorithm does.
     let start = Instant::now();
     let pattern = crate::AaMode::None.pattern();
-    let mut tile = TileBuffer::new((0, 0, view.width, view.height), &pattern, &[]);
+    let mut tile = TileBuffer::new(PixelRect::new(0, 0, view.width, view.height), &pattern, &[]);
     tile.triangle_id = samples.triangle_id;
     tile.depth = samples.depth;
     tile.coverage_writes = samples.fragments.into_iter().map(u32::from).collect();

@@ -25,6 +25,7 @@ pub use scene_file::{SceneFile, load_scene_file, load_scene_file_str};
 pub use validate::{MAX_COORDINATE, PartLocation, validate_part};
 
 use crate::camera::Camera;
+use crate::ground::Bounds;
 
 /// Triangle geometry in world space, structure-of-arrays.
 ///
@@ -125,38 +126,6 @@ impl Mesh {
             }
         }
         b
-    }
-}
-
-/// An axis-aligned box.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Bounds {
-    pub min: Vec3,
-    pub max: Vec3,
-}
-
-impl Bounds {
-    pub const EMPTY: Bounds = Bounds {
-        min: Vec3::splat(f32::INFINITY),
-        max: Vec3::splat(f32::NEG_INFINITY),
-    };
-
-    pub fn grow(&mut self, p: Vec3) {
-        self.min = self.min.min(p);
-        self.max = self.max.max(p);
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.min.cmpgt(self.max).any()
-    }
-
-    pub fn center(&self) -> Vec3 {
-        (self.min + self.max) * 0.5
-    }
-
-    /// Radius of the bounding sphere around [`Bounds::center`].
-    pub fn radius(&self) -> f32 {
-        (self.max - self.min).length() * 0.5
     }
 }
 
@@ -358,13 +327,6 @@ impl Scene {
         Camera::framing(&self.bounds())
     }
 
-    /// The effects this scene calls for, from the scene alone (the
-    /// [`EffectPlan`](crate::shade::plan::EffectPlan)'s words): `textures`,
-    /// `shadows`, `reflections`, `transparency`.
-    pub fn effects(&self) -> Vec<&'static str> {
-        crate::shade::plan::EffectPlan::of(self).names()
-    }
-
     /// Checks the invariants of [`Mesh`] and that material ids are in range.
     pub fn validate(&self) -> Result<(), SceneError> {
         let location = PartLocation::whole(&self.source);
@@ -425,7 +387,8 @@ pub fn load_named_or_path(arg: &str, scenes_dir: &Path) -> Result<Scene, SceneEr
         }
         return Err(SceneError::UnknownScene {
             name: arg.to_string(),
-            available: builtin_names(scenes_dir),
+            // Listing what is there is a courtesy of this error message.
+            available: builtin_names(scenes_dir).unwrap_or_default(),
         });
     }
     if !as_path.exists() {
@@ -437,21 +400,24 @@ pub fn load_named_or_path(arg: &str, scenes_dir: &Path) -> Result<Scene, SceneEr
     load_path(as_path)
 }
 
-/// Names of the `*.toml` scenes in `scenes_dir`, sorted.
-pub fn builtin_names(scenes_dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(scenes_dir)
-        .into_iter()
-        .flatten()
-        .flatten()
-        .filter_map(|e| {
-            let p = e.path();
-            (p.extension().and_then(|x| x.to_str()) == Some("toml"))
-                .then(|| p.file_stem()?.to_str().map(str::to_string))
-                .flatten()
-        })
-        .collect();
+/// Names of the `*.toml` scenes in `scenes_dir`, sorted; an error naming the
+/// folder when it cannot be read (never an empty list standing for one).
+pub fn builtin_names(scenes_dir: &Path) -> Result<Vec<String>, SceneError> {
+    let io = |e: std::io::Error| SceneError::Io {
+        path: scenes_dir.display().to_string(),
+        message: e.to_string(),
+    };
+    let mut names = Vec::new();
+    for entry in std::fs::read_dir(scenes_dir).map_err(io)? {
+        let p = entry.map_err(io)?.path();
+        if p.extension().and_then(|x| x.to_str()) == Some("toml")
+            && let Some(stem) = p.file_stem().and_then(|s| s.to_str())
+        {
+            names.push(stem.to_string());
+        }
+    }
     names.sort();
-    names
+    Ok(names)
 }
 
 /// The folder of built-in scenes: `$CONTINUUM_SCENES`, else `scenes/` beside the

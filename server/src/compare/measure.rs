@@ -8,9 +8,9 @@
 use std::collections::HashMap;
 use std::path::Path;
 
+use super::peer::run_peer;
 use anyhow::Context;
 use continuum::metrics::{self, ImageError};
-use continuum::peer::run_peer;
 use continuum::{
     AaMode, AlgorithmId, Camera, Framebuffer, Precision, PreparedScene, RenderRequest, View, maps,
     render,
@@ -79,7 +79,7 @@ pub fn measure_cell(
         if !scene.references.contains_key(&key) {
             progress.set_message(format!(
                 "{name} {key}: {} reference",
-                continuum::aa::REFERENCE
+                continuum::AaMode::REFERENCE
             ));
             let r = pool.install(|| Reference::render(&scene.prepared, &camera, sweep.size))?;
             scene.references.insert(key.clone(), r);
@@ -92,14 +92,11 @@ pub fn measure_cell(
         .iter()
         .copied()
         .filter(|&entry| match entry {
-            Entry::Algorithm(a) => {
-                camera.viewport.serves(a)
-                    && cell.precision.serves(a.family())
-                    && (a != AlgorithmId::GpuRaster
-                        || (cell.aa == AaMode::None
-                            // gpu-raster draws opaque surfaces only.
-                            && scene.prepared.triangle_opacity.is_empty()))
-            }
+            Entry::Algorithm(a) => continuum::check(
+                &algorithm_request(a, &camera, cell, sweep),
+                Some(&scene.prepared),
+            )
+            .is_ok(),
             // Peers cast one ray per pixel in their own precision.
             Entry::Peer(_) => cell.aa == AaMode::None && cell.precision == Precision::F32,
         })
@@ -208,14 +205,9 @@ fn algorithm_request(
     sweep: &Sweep,
 ) -> RenderRequest {
     RenderRequest {
-        algorithm,
-        oracles: None,
-        camera: camera.clone(),
-        width: sweep.size.0,
-        height: sweep.size.1,
         aa: cell.aa,
         precision: cell.precision,
-        texture_filter: Default::default(),
+        ..RenderRequest::new(algorithm, camera.clone(), sweep.size.0, sweep.size.1)
     }
 }
 
@@ -383,21 +375,15 @@ impl Reference {
         (width, height): (u32, u32),
     ) -> Result<Reference, CliError> {
         let request = |aa| RenderRequest {
-            algorithm: AlgorithmId::ThreeDBin,
-            oracles: None,
-            camera: camera.clone(),
-            width,
-            height,
             aa,
-            precision: Precision::F32,
-            texture_filter: Default::default(),
+            ..RenderRequest::new(AlgorithmId::ThreeDBin, camera.clone(), width, height)
         };
         let run = |aa| {
             render(prepared, &request(aa))
                 .map(|o| o.framebuffer.color)
                 .map_err(|e| CliError::Usage(format!("{e}")))
         };
-        let color = run(continuum::aa::REFERENCE)?;
+        let color = run(continuum::AaMode::REFERENCE)?;
         let edges = metrics::differing_pixels(&run(AaMode::None)?, &color);
         Ok(Reference {
             color,

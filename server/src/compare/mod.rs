@@ -7,6 +7,7 @@
 //! (`--shard I/N`) and be merged (`continuum compare merge`).
 
 mod measure;
+pub mod peer;
 mod report;
 pub mod sweep;
 
@@ -229,12 +230,15 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         Some(path) => read_sweep_file(path)?,
         None => sweep_from_flags(args),
     };
-    let sweep =
-        Sweep::new(file, || continuum::scene::builtin_names(&dir)).map_err(|e| match e {
-            CliError::Usage(m) if args.sweep.is_none() => CliError::Usage(format!("--{m}")),
-            CliError::Usage(m) => CliError::Usage(format!("--sweep: {m}")),
-            other => other,
-        })?;
+    let sweep = Sweep::new(file, || {
+        continuum::scene::builtin_names(&dir)
+            .map_err(|e| CliError::Usage(format!("scenes-dir: {e}")))
+    })
+    .map_err(|e| match e {
+        CliError::Usage(m) if args.sweep.is_none() => CliError::Usage(format!("--{m}")),
+        CliError::Usage(m) => CliError::Usage(format!("--sweep: {m}")),
+        other => other,
+    })?;
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     let threads = sweep
         .threads
@@ -493,9 +497,9 @@ fn machine(threads: usize) -> Value {
         "gpu": gpu_adapter(),
         "lp_num_threads": std::env::var("LP_NUM_THREADS").ok(),
         // The coverage kernels' instruction set (`CONTINUUM_SIMD=portable` forces the portable one).
-        "simd": match continuum::simd::isa() {
-            continuum::simd::Isa::Avx2 => "avx2",
-            continuum::simd::Isa::Portable => "portable",
+        "simd": match continuum::isa() {
+            continuum::Isa::Avx2 => "avx2",
+            continuum::Isa::Portable => "portable",
         },
     })
 }
@@ -609,7 +613,7 @@ fn table_text(rows: &[Row]) -> String {
 
 #[cfg(feature = "gpu")]
 fn gpu_adapter() -> Option<String> {
-    continuum::gpu::gpu().ok().map(|g| g.adapter.clone())
+    continuum::gpu_adapter()
 }
 
 #[cfg(not(feature = "gpu"))]

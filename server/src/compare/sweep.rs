@@ -19,9 +19,9 @@
 
 use std::path::Path;
 
-use continuum::peer::PeerId;
-use continuum::request::{parse_algorithm, parse_size};
+use super::peer::PeerId;
 use continuum::{AaMode, AlgorithmId, Precision, Viewport};
+use continuum::{parse_algorithm, parse_size};
 use serde::{Deserialize, Serialize};
 
 use crate::CliError;
@@ -76,7 +76,7 @@ impl ViewportChoice {
                     height: camera.framing_height(),
                 })
             }
-            ViewportChoice::Named(text) => continuum::request::parse_viewport(text, camera)
+            ViewportChoice::Named(text) => Viewport::parse(text, camera.viewport)
                 .map_err(|e| CliError::Usage(format!("viewports: {}", e.message))),
         }
     }
@@ -112,10 +112,13 @@ pub fn read_sweep_file(path: &Path) -> Result<SweepFile, CliError> {
 
 impl Sweep {
     /// Checks every key of `file`; `builtin` lists the scenes when it names none.
-    pub fn new(file: SweepFile, builtin: impl FnOnce() -> Vec<String>) -> Result<Sweep, CliError> {
+    pub fn new(
+        file: SweepFile,
+        builtin: impl FnOnce() -> Result<Vec<String>, CliError>,
+    ) -> Result<Sweep, CliError> {
         let bad = |key: &str, m: String| CliError::Usage(format!("{key}: {m}"));
         let scenes = if file.scenes.is_empty() {
-            builtin()
+            builtin()?
         } else {
             file.scenes.clone()
         };

@@ -3,7 +3,8 @@
 //! sample, algorithms agree per sample, and shading runs as often as each mode
 //! promises.
 
-use continuum::{AaMode, AlgorithmId, Family, Viewport};
+use continuum::{AaMode, AlgorithmId, Viewport};
+use continuum_tests::matrix::Matrix;
 use continuum_tests::{exact_camera, pixel_point, prepared, render_aa, scene_from_triangles};
 use glam::{DVec2, Vec3};
 
@@ -184,37 +185,21 @@ fn algorithms_agree_per_sample() {
         },
         AaMode::Ssaa(16),
     ];
-    for name in continuum_tests::builtin_scenes() {
-        let scene = prepared(&name);
-        let mut camera = scene.scene.first_camera();
-        let viewports: &[Viewport] = if name == "teapots" {
-            &[Viewport::Parabolic]
-        } else {
-            &[]
-        };
-        let own = camera.viewport;
-        for &viewport in std::iter::once(&own).chain(viewports) {
-            camera.viewport = viewport;
-            for mode in modes {
-                let mut reference: Vec<(Family, String, continuum::Hashes)> = Vec::new();
-                for algorithm in AlgorithmId::CPU.into_iter().filter(|a| viewport.serves(*a)) {
-                    let out = render_aa(&scene, algorithm, &camera, (64, 48), mode);
-                    match reference.iter().find(|(f, _, _)| *f == algorithm.family()) {
-                        Some((_, first, hashes)) => assert_eq!(
-                            (&hashes.samples, &hashes.color),
-                            (&out.hashes.samples, &out.hashes.color),
-                            "{name} {viewport} {mode}: {algorithm} differs from {first}"
-                        ),
-                        None => reference.push((
-                            algorithm.family(),
-                            algorithm.to_string(),
-                            out.hashes.clone(),
-                        )),
-                    }
-                }
-            }
-        }
-    }
+    let every_scene = Matrix {
+        aa: modes.to_vec(),
+        ..Matrix::new()
+    };
+    let compared = every_scene.assert_families_agree();
+    // 12 scenes × 3 modes, 5 3D comparisons and 1 2D one each.
+    assert!(compared >= 12 * 3 * 6, "only {compared} comparisons");
+    let parabolic = Matrix {
+        scenes: vec!["teapots".into()],
+        viewports: vec![Some(Viewport::Parabolic)],
+        ..every_scene
+    };
+    // 3dr-brute, 3dr-bin and raycast serve the parabolic viewport.
+    let compared = parabolic.assert_families_agree();
+    assert_eq!(compared, 3 * 2, "parabolic comparisons");
 }
 
 /// MSAA shades once per pixel per triangle it shows, SSAA once per covered

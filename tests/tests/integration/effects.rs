@@ -1,10 +1,10 @@
 //! Effects run only when the scene calls for them, each counted; secondary rays
 //! are watertight; and every algorithm shades the same image with effects on.
 
+use continuum::TextureFilter;
+use continuum::internal::{Rays, intersect};
 use continuum::metrics::flip_mean;
 use continuum::scene::Scene;
-use continuum::shade::secondary::{Rays, intersect};
-use continuum::shade::texture::TextureFilter;
 use continuum::{AaMode, AlgorithmId, Family, PreparedScene, RenderRequest};
 use continuum_tests::{builtin_scenes, prepared, render_with};
 use glam::Vec3;
@@ -209,14 +209,14 @@ fn render_filtered(
     filter: TextureFilter,
 ) -> continuum::RenderOutput {
     let request = RenderRequest {
-        algorithm: AlgorithmId::ThreeDBrute,
-        oracles: None,
-        camera: scene.scene.camera(camera).expect("a camera of the scene"),
-        width: 192,
-        height: 108,
         aa,
-        precision: Default::default(),
         texture_filter: filter,
+        ..RenderRequest::new(
+            AlgorithmId::ThreeDBrute,
+            scene.scene.camera(camera).expect("a camera of the scene"),
+            192,
+            108,
+        )
     };
     continuum::render(scene, &request).expect("renders")
 }
@@ -352,14 +352,8 @@ fn a_gltf_base_colour_texture_is_decoded_and_mapped() {
     );
     let camera = quad_camera();
     let request = RenderRequest {
-        algorithm: AlgorithmId::Raycast,
-        oracles: None,
-        camera,
-        width: 64,
-        height: 64,
-        aa: AaMode::None,
-        precision: Default::default(),
         texture_filter: TextureFilter::Nearest,
+        ..RenderRequest::new(AlgorithmId::Raycast, camera, 64, 64)
     };
     let out = continuum::render(&prepared, &request).expect("renders");
     let textures = out
@@ -585,16 +579,7 @@ fn gpu_raster_refuses_see_through_scenes_naming_the_field() {
     let pane = prepared("pane");
     let err = continuum::render(
         &pane,
-        &RenderRequest {
-            algorithm: AlgorithmId::GpuRaster,
-            oracles: None,
-            camera: pane.scene.first_camera(),
-            width: 32,
-            height: 24,
-            aa: AaMode::None,
-            precision: Default::default(),
-            texture_filter: Default::default(),
-        },
+        &RenderRequest::new(AlgorithmId::GpuRaster, pane.scene.first_camera(), 32, 24),
     )
     .expect_err("gpu-raster draws opaque surfaces only");
     assert_eq!(err.field, "algorithm", "{err}");
@@ -667,14 +652,8 @@ fn gltf_uv_sets_sampler_wrap_modes_and_vertex_colours_are_honoured() {
     let camera = quad_camera();
     let render = |scene: &Scene| {
         let request = RenderRequest {
-            algorithm: AlgorithmId::ThreeDFull,
-            oracles: None,
-            camera: camera.clone(),
-            width: 64,
-            height: 64,
-            aa: AaMode::None,
-            precision: Default::default(),
             texture_filter: TextureFilter::Nearest,
+            ..RenderRequest::new(AlgorithmId::ThreeDFull, camera.clone(), 64, 64)
         };
         continuum::render(&PreparedScene::new(scene.clone()), &request).expect("renders")
     };
@@ -690,7 +669,7 @@ fn gltf_uv_sets_sampler_wrap_modes_and_vertex_colours_are_honoured() {
     let mut white = scene.clone();
     white.mesh.colors.clear();
     let full = pixel(&render(&white), 18);
-    let ratio = continuum::shade::decode_srgb(red[0]) / continuum::shade::decode_srgb(full[0]);
+    let ratio = continuum::decode_srgb(red[0]) / continuum::decode_srgb(full[0]);
     assert!((ratio - 0.5).abs() < 0.01, "{ratio}: {red:?} vs {full:?}");
 }
 

@@ -2,8 +2,8 @@
 //! algorithm, precision and viewport, at the origin and at offsets up to 10⁷,
 //! holds every invariant — and the checks do catch a broken render.
 
-use continuum::hardcases::{self, Check, HardCase, Violations, reference::Reference};
 use continuum::{AlgorithmId, BACKGROUND, PreparedScene, RenderRequest, View, render};
+use continuum_hardcases::{self as hardcases, Check, HardCase, Violations, reference::Reference};
 use std::path::Path;
 
 fn cases_dir() -> std::path::PathBuf {
@@ -72,16 +72,7 @@ fn the_checks_catch_double_coverage_holes_wrong_triangles_and_bad_depth() {
     let reference = Reference::compute(&scene, &view);
     let mut out = render(
         &scene,
-        &RenderRequest {
-            algorithm: AlgorithmId::ThreeDBrute,
-            oracles: None,
-            camera,
-            width: 64,
-            height: 64,
-            aa: continuum::AaMode::None,
-            precision: Default::default(),
-            texture_filter: Default::default(),
-        },
+        &RenderRequest::new(AlgorithmId::ThreeDBrute, camera, 64, 64),
     )
     .expect("renders");
     let check = |out: &continuum::RenderOutput| {
@@ -150,9 +141,9 @@ mod random {
     //! jittered icospheres) seen by random cameras through every viewport hold
     //! every invariant of the suite in every algorithm.
 
-    use continuum::hardcases::{self, ViewCase};
     use continuum::scene::procedural::{GridParams, SphereParams};
     use continuum::{Camera, Viewport};
+    use continuum_hardcases::{self as hardcases, ViewCase};
     use glam::{Quat, Vec3};
     use proptest::prelude::*;
 

@@ -4,6 +4,7 @@ mod aa;
 mod agreement;
 mod conformance;
 mod effects;
+mod golden;
 mod hard_cases;
 mod loaders;
 mod oracles;

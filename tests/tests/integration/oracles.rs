@@ -67,29 +67,25 @@ proptest! {
 #[test]
 fn bad_oracles_are_errors_naming_the_field() {
     let p = prepared("box");
-    let camera = p.scene.first_camera();
-    for (algorithm, text) in [
+    let cases = [
         (AlgorithmId::ThreeDFull, "split=7"),
         (AlgorithmId::ThreeDFull, "speed=fast"),
         (AlgorithmId::ThreeDFull, "outside=maybe"),
         (AlgorithmId::ThreeDBin, "split=8"),
         (AlgorithmId::Raycast, "binning=on"),
         (AlgorithmId::ThreeDFull, "binning"),
-    ] {
-        let err = continuum::render(
-            &p,
-            &continuum::RenderRequest {
-                algorithm,
-                oracles: Some(text.into()),
-                camera: camera.clone(),
-                width: 8,
-                height: 8,
-                aa: continuum::AaMode::None,
-                precision: Default::default(),
-                texture_filter: Default::default(),
-            },
-        )
-        .expect_err(text);
+    ];
+    for (algorithm, text) in cases {
+        // The words through the front door, then the render.
+        let words = continuum::RenderWords {
+            oracles: Some(text.into()),
+            size: Some("8x8".into()),
+            ..continuum::RenderWords::new(algorithm.as_str())
+        };
+        let err = words
+            .request(&p.scene)
+            .and_then(|request| continuum::render(&p, &request).map(|_| ()))
+            .expect_err(text);
         assert_eq!(err.field, "oracles", "{text}: {err}");
     }
 }

@@ -3,11 +3,11 @@
 //! sample to binning, closed meshes stay watertight on curved viewports, and the
 //! golden images of `teapots` hold.
 
-use std::path::PathBuf;
-
 use continuum::{AlgorithmId, Camera, Family, RenderOutput, RenderRequest, Viewport, render};
+use continuum_tests::golden::assert_golden;
 use continuum_tests::{
     builtin_scenes, explain_2d_3d, id_differences, prepared, render_with, render_with_oracles,
+    serves,
 };
 use glam::Vec3;
 
@@ -77,7 +77,7 @@ fn three_d_family_and_raycast_agree_on_every_viewport() {
                 assert!(covered > 0, "{what}: nothing drawn");
                 let served = AlgorithmId::CPU
                     .into_iter()
-                    .filter(|a| a.family() == Family::ThreeD && viewport.serves(*a));
+                    .filter(|&a| a.family() == Family::ThreeD && serves(a, viewport));
                 for algorithm in served.skip(1) {
                     let out = render_with(&scene, algorithm, &camera, W, H);
                     assert_identical(&what, &reference, &out);
@@ -172,14 +172,8 @@ fn incremental_evaluation_decides_like_direct_evaluation() {
     let e = render(
         &scene,
         &RenderRequest {
-            algorithm: AlgorithmId::ThreeDBrute,
-            oracles: Some("incremental=on".into()),
-            camera,
-            width: 64,
-            height: 32,
-            aa: continuum::AaMode::None,
-            precision: Default::default(),
-            texture_filter: Default::default(),
+            oracles: continuum::Oracles::parse("incremental=on").expect("valid words"),
+            ..RenderRequest::new(AlgorithmId::ThreeDBrute, camera, 64, 32)
         },
     )
     .unwrap_err();
@@ -238,16 +232,7 @@ fn unsupported_pairings_are_errors_listing_the_supported_ones() {
         for algorithm in AlgorithmId::CPU {
             let result = render(
                 &scene,
-                &RenderRequest {
-                    algorithm,
-                    oracles: None,
-                    camera: camera.clone(),
-                    width: 32,
-                    height: 16,
-                    aa: continuum::AaMode::None,
-                    precision: Default::default(),
-                    texture_filter: Default::default(),
-                },
+                &RenderRequest::new(algorithm, camera.clone(), 32, 16),
             );
             let served = matches!(
                 algorithm,
@@ -265,7 +250,7 @@ fn unsupported_pairings_are_errors_listing_the_supported_ones() {
     }
 }
 
-/// The golden images: `teapots` in all four viewports. Regenerate with
+/// The golden images: `teapots` in all four viewports, exactly. Regenerate with
 /// `UPDATE_GOLDEN=1 cargo test -p continuum-tests golden`.
 #[test]
 fn golden_teapots_in_every_viewport() {
@@ -298,34 +283,13 @@ fn golden_teapots_in_every_viewport() {
         ("parabolic", above, 320, 320),
         ("latlong", among, 640, 320),
     ];
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("golden/viewports");
-    let update = std::env::var_os("UPDATE_GOLDEN").is_some();
     for (kind, camera, w, h) in cases {
         let out = render_with(&scene, AlgorithmId::ThreeDBin, &camera, w, h);
         let raycast = render_with(&scene, AlgorithmId::Raycast, &camera, w, h);
         assert_identical(kind, &out, &raycast);
-        let image = continuum::maps::color_image(&out.framebuffer);
-        let path = dir.join(format!("teapots_{kind}.png"));
-        if update {
-            std::fs::create_dir_all(&dir).expect("golden folder");
-            image.save(&path).expect("write golden image");
-            continue;
-        }
-        let golden = image::open(&path)
-            .unwrap_or_else(|e| panic!("{}: {e} (UPDATE_GOLDEN=1 writes it)", path.display()))
-            .to_rgba8();
-        assert_eq!(golden.dimensions(), image.dimensions(), "{kind}");
-        // Bit-exact on one machine; a few pixels of slack for libm differences
-        // in the latitude–longitude directions elsewhere.
-        let differing = golden
-            .pixels()
-            .zip(image.pixels())
-            .filter(|(a, b)| a != b)
-            .count();
-        assert!(
-            differing * 1000 <= (w * h) as usize,
-            "{kind}: {differing} pixels differ from {}",
-            path.display()
+        assert_golden(
+            &format!("viewports/teapots_{kind}"),
+            &continuum::maps::color_image(&out.framebuffer),
         );
     }
 }

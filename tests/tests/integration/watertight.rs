@@ -2,23 +2,32 @@
 //! pixel gets exactly one coverage write, in every algorithm.
 
 use continuum::AlgorithmId;
-use continuum_tests::{prepared, render_with};
+use continuum_tests::matrix::{Cameras, Matrix};
 
-fn assert_every_pixel_covered_once(scene: &str, camera: &str) {
-    let prepared = prepared(scene);
-    let camera = prepared.scene.camera(camera).expect("camera exists");
-    for algorithm in AlgorithmId::ALL {
-        for (w, h) in [(640, 480), (333, 201)] {
-            let out = render_with(&prepared, algorithm, &camera, w, h);
-            let hist = out.stats.coverage_histogram;
+fn assert_every_pixel_covered_once(scene: &str, camera: &'static str) {
+    for (w, h) in [(640, 480), (333, 201)] {
+        let rendered = Matrix {
+            scenes: vec![scene.into()],
+            cameras: Cameras::Named(camera),
+            algorithms: AlgorithmId::ALL.to_vec(),
+            size: (w, h),
+            ..Matrix::new()
+        }
+        .run(|cell| {
+            let hist = cell.output.stats.coverage_histogram;
             assert_eq!(
                 (hist.zero, hist.many),
                 (0, 0),
-                "{scene}/{} with {algorithm} at {w}x{h}: {hist:?}",
-                camera.name
+                "{} at {w}x{h}: {hist:?}",
+                cell.label()
             );
-            assert_eq!(hist.one, u64::from(w * h));
-        }
+            assert_eq!(hist.one, u64::from(w * h), "{}", cell.label());
+        });
+        assert_eq!(
+            rendered,
+            AlgorithmId::ALL.len(),
+            "{scene}/{camera} at {w}x{h}"
+        );
     }
 }
 

@@ -8,9 +8,9 @@
 
 use glam::{Vec2, Vec4};
 
-use crate::request::FieldError;
+use crate::color::decode_srgb;
+use crate::ground::FieldError;
 use crate::scene::{ImageSource, Wrap};
-use crate::shade::decode_srgb;
 
 /// How texture lookups are filtered.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]

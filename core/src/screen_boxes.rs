@@ -17,11 +17,11 @@
 use glam::{DMat3, DVec3, Vec3};
 use rayon::prelude::*;
 
-use super::PixelRect;
-use crate::aa::SampleSpan;
 use crate::camera::View;
 use crate::clip::{ClipPlane, clip_triangle};
 use crate::edge::EPS;
+use crate::ground::PixelRect;
+use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
 
 /// Non-planar viewports' screen box: the bounds of the triangle's cap of
@@ -473,8 +473,8 @@ mod tests {
                         regions.push(clamp(
                             f64::from(r.x0) - 2.0,
                             f64::from(r.y0) - 2.0,
-                            f64::from(r.x1) + 2.0,
-                            f64::from(r.y1) + 2.0,
+                            f64::from(r.x1) + 1.0,
+                            f64::from(r.y1) + 1.0,
                         ));
                     }
                     for v in p {
@@ -497,9 +497,7 @@ mod tests {
                                     continue;
                                 }
                                 covered += 1;
-                                let inside = rect.is_some_and(|r| {
-                                    (r.x0..=r.x1).contains(&px) && (r.y0..=r.y1).contains(&py)
-                                });
+                                let inside = rect.is_some_and(|r| r.contains(px, py));
                                 assert!(
                                     inside,
                                     "case {case}: sample ({sx}, {sy}) of {p:?} is covered but outside {rect:?} ({view:?})"

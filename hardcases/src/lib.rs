@@ -46,13 +46,11 @@ use std::path::{Path, PathBuf};
 use glam::{DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
-use crate::algorithm::{AlgorithmId, Family};
-use crate::camera::{Camera, View, Viewport};
-use crate::precision::Precision;
-use crate::prepared::PreparedScene;
-use crate::render::{RenderOutput, RenderRequest, render};
-use crate::scene::{LightKind, Scene, SceneError, SceneFile};
-use crate::{AaMode, BACKGROUND};
+use continuum::scene::{LightKind, SceneFile};
+use continuum::{
+    AlgorithmId, BACKGROUND, Bounds, Camera, Family, Precision, PreparedScene, RenderOutput,
+    RenderRequest, Scene, SceneError, View, Viewport, render,
+};
 use reference::{Expected, Reference};
 
 /// Distances from the origin every case is also rendered at, along
@@ -311,13 +309,23 @@ pub struct Check {
 }
 
 /// Every (algorithm, precision) that serves `viewport` and that this machine
-/// can run (see [`crate::unavailable`]; the suite reports the others as not
+/// can run ([`continuum::check`] says so; the suite reports the others as not
 /// run): every algorithm at f32, the 3D family also at f64, the 2D family also
 /// in fixed point.
 pub fn variants(viewport: &Viewport) -> Vec<(AlgorithmId, Precision)> {
+    let camera = Camera {
+        viewport: *viewport,
+        ..Camera::framing(&Bounds::EMPTY)
+    };
     variants_of_all()
         .into_iter()
-        .filter(|&(a, _)| viewport.serves(a) && crate::unavailable(a).is_none())
+        .filter(|&(algorithm, precision)| {
+            let request = RenderRequest {
+                precision,
+                ..RenderRequest::new(algorithm, camera.clone(), 1, 1)
+            };
+            continuum::check(&request, None).is_ok()
+        })
         .collect()
 }
 
@@ -325,7 +333,7 @@ pub fn variants(viewport: &Viewport) -> Vec<(AlgorithmId, Precision)> {
 pub fn not_run() -> Vec<(AlgorithmId, String)> {
     AlgorithmId::ALL
         .into_iter()
-        .filter_map(|a| Some((a, crate::unavailable(a)?)))
+        .filter_map(|a| Some((a, continuum::unavailable(a)?)))
         .collect()
 }
 
@@ -411,14 +419,8 @@ pub fn check_view(
                 .cloned(),
         };
         let request = RenderRequest {
-            algorithm,
-            oracles: None,
-            camera: camera.clone(),
-            width,
-            height,
-            aa: AaMode::None,
             precision,
-            texture_filter: Default::default(),
+            ..RenderRequest::new(algorithm, camera.clone(), width, height)
         };
         let out = match catch_unwind(AssertUnwindSafe(|| render(scene, &request))) {
             Ok(Ok(out)) => {

@@ -23,9 +23,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::BACKGROUND;
-use crate::camera::View;
-use crate::prepared::PreparedScene;
+use continuum::{BACKGROUND, PreparedScene, View};
 
 /// Radius in pixels for renders that decide coverage on the pixel's own
 /// coordinates (f32, f64).

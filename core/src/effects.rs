@@ -60,10 +60,6 @@ impl EffectPlan {
         .filter_map(|(runs, name)| runs.then_some(name))
         .collect()
     }
-
-    pub fn is_empty(&self) -> bool {
-        self.shadow_lights.is_empty() && !self.reflections && !self.textures && !self.transparency
-    }
 }
 
 /// What the effects of one tile cost: rays per shadow-casting light (in plan
@@ -193,6 +189,15 @@ pub struct EffectStats {
     pub worker_ms: f64,
 }
 
+impl Scene {
+    /// The effects this scene calls for, from the scene alone (the
+    /// [`EffectPlan`]'s words): `textures`,
+    /// `shadows`, `reflections`, `transparency`.
+    pub fn effects(&self) -> Vec<&'static str> {
+        EffectPlan::of(self).names()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -228,7 +233,7 @@ mod tests {
         let plan = EffectPlan::of(&scene);
         assert_eq!(plan.shadow_lights, vec![2]);
         assert!(plan.reflections);
-        assert!(EffectPlan::of(&Scene::default()).is_empty());
+        assert!(EffectPlan::of(&Scene::default()).names().is_empty());
     }
 
     #[test]

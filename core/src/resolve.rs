@@ -28,9 +28,10 @@ use std::time::Instant;
 use glam::Vec3;
 
 use crate::camera::View;
+use crate::color::{BACKGROUND_COLOR, OUTSIDE_VIEWPORT_COLOR, encode_rgb, linear_rgb};
+use crate::effects::EffectCounters;
 use crate::framebuffer::{BACKGROUND, Fragment, ResolvedTile, TileBuffer, wins_depth_test};
-use crate::shade::plan::EffectCounters;
-use crate::shade::{BACKGROUND_COLOR, OUTSIDE_VIEWPORT_COLOR, Shader, encode_rgb, linear_rgb};
+use crate::shade::Shader;
 use crate::stats::CoverageHistogram;
 
 /// Most stored samples a pattern has (`ssaa:256`).
@@ -111,7 +112,7 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
     let background = linear_rgb(BACKGROUND_COLOR);
     let outside = linear_rgb(OUTSIDE_VIEWPORT_COLOR);
     let mut out = ResolvedTile {
-        rect: [tile.x0, tile.y0, tile.x1, tile.y1],
+        rect: tile.rect(),
         color: vec![[0; 4]; pixels],
         depth: tile.depth[..pixels].to_vec(),
         triangle_id: tile.triangle_id[..pixels].to_vec(),
@@ -393,16 +394,7 @@ mod tests {
                 (AlgorithmId::Raycast, &camera),
                 (AlgorithmId::Raycast, &parabolic),
             ] {
-                let request = RenderRequest {
-                    algorithm,
-                    oracles: None,
-                    camera: camera.clone(),
-                    width: 96,
-                    height: 64,
-                    aa: Default::default(),
-                    precision: Default::default(),
-                    texture_filter: Default::default(),
-                };
+                let request = RenderRequest::new(algorithm, camera.clone(), 96, 64);
                 let colors = |general: bool| {
                     FORCE_GENERAL.store(general, Ordering::Relaxed);
                     let out = render(&scene, &request);

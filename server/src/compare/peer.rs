@@ -15,9 +15,7 @@ use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use rayon::prelude::*;
 
-use crate::camera::{View, pixel_center};
-use crate::framebuffer::BACKGROUND;
-use crate::prepared::PreparedScene;
+use continuum::{BACKGROUND, PreparedScene, View, pixel_center};
 
 /// A peer renderer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -161,9 +159,7 @@ mod embree_peer {
     use rayon::prelude::*;
 
     use super::{PeerRun, timed};
-    use crate::camera::{View, pixel_center};
-    use crate::framebuffer::BACKGROUND;
-    use crate::prepared::PreparedScene;
+    use continuum::{BACKGROUND, PreparedScene, View, pixel_center};
 
     pub fn run(scene: &PreparedScene, view: &View, repeat: u32, stream: bool) -> PeerRun {
         let start = Instant::now();

@@ -1,0 +1,306 @@
+//! Points of the continuum: the oracle settings of Fig. 7 (paper §5) that make
+//! each algorithm, the typed settings a request adds on top, and the paper's
+//! Fig. 10 instruction costs.
+
+use std::fmt;
+
+use crate::ground::{AlgorithmId, FieldError};
+use crate::viewport::Viewport;
+
+/// Oracle settings a request puts on top of its algorithm's (paper §5, Fig. 7),
+/// in the CLI's words `key=value,…`: `outside`, `occluded`, `binning`,
+/// `early_z`, `incremental` (`on`/`off`), `split` (`off` or a size in pixels),
+/// `frustum` and `leaf` (sizes in pixels). `None` keeps the algorithm's own.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Oracles {
+    pub outside: Option<bool>,
+    pub occluded: Option<bool>,
+    pub split: Option<Option<u32>>,
+    pub frustum: Option<u32>,
+    pub binning: Option<bool>,
+    pub early_z: Option<bool>,
+    pub leaf: Option<u32>,
+    pub incremental: Option<bool>,
+}
+
+impl Oracles {
+    /// No setting given.
+    pub fn is_empty(&self) -> bool {
+        *self == Oracles::default()
+    }
+
+    /// Parses `key=value` pairs separated by commas; a later pair of a key
+    /// replaces an earlier one. Errors name the field `oracles`.
+    pub fn parse(text: &str) -> Result<Oracles, FieldError> {
+        let bad = |m: String| FieldError::new("oracles", m);
+        let mut o = Oracles::default();
+        for pair in text.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+            let (key, value) = pair
+                .split_once('=')
+                .ok_or_else(|| bad(format!("'{pair}' is not key=value")))?;
+            let switch = || match value {
+                "on" | "true" => Ok(Some(true)),
+                "off" | "false" => Ok(Some(false)),
+                _ => Err(bad(format!("{key}: '{value}' is not on or off"))),
+            };
+            let size = || match value.parse::<u32>() {
+                Ok(n) if n.is_power_of_two() && (4..=1024).contains(&n) => Ok(n),
+                _ => Err(bad(format!(
+                    "{key}: '{value}' is not a power of two in 4..=1024"
+                ))),
+            };
+            match key {
+                "outside" => o.outside = switch()?,
+                "occluded" => o.occluded = switch()?,
+                "binning" => o.binning = switch()?,
+                "early_z" => o.early_z = switch()?,
+                "incremental" => o.incremental = switch()?,
+                "leaf" => o.leaf = Some(size()?),
+                "frustum" => o.frustum = Some(size()?),
+                "split" => o.split = Some(if value == "off" { None } else { Some(size()?) }),
+                _ => {
+                    return Err(bad(format!(
+                        "unknown oracle '{key}'; oracles are: outside, occluded, split, frustum, binning, early_z, leaf, incremental"
+                    )));
+                }
+            }
+        }
+        Ok(o)
+    }
+}
+
+impl fmt::Display for Oracles {
+    /// The settings given, in the words [`Oracles::parse`] reads.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let word = |on: bool| if on { "on" } else { "off" };
+        let mut pairs: Vec<String> = Vec::new();
+        let switches = [
+            ("outside", self.outside),
+            ("occluded", self.occluded),
+            ("binning", self.binning),
+            ("early_z", self.early_z),
+            ("incremental", self.incremental),
+        ];
+        for (key, v) in switches {
+            if let Some(v) = v {
+                pairs.push(format!("{key}={}", word(v)));
+            }
+        }
+        if let Some(split) = self.split {
+            pairs.push(match split {
+                Some(n) => format!("split={n}"),
+                None => "split=off".into(),
+            });
+        }
+        for (key, v) in [("frustum", self.frustum), ("leaf", self.leaf)] {
+            if let Some(n) = v {
+                pairs.push(format!("{key}={n}"));
+            }
+        }
+        f.write_str(&pairs.join(","))
+    }
+}
+
+/// How samples are enumerated inside a triangle's box.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SampleOracles {
+    /// Hierarchical tile tests instead of testing every sample of the box.
+    pub binning: bool,
+    /// Blocks of this many pixels square (a power of two) are tested sample by sample.
+    pub leaf: u32,
+    /// Skip blocks that the hierarchical w-buffer shows are hidden.
+    pub early_z: bool,
+    /// Parabolic viewport: evaluate edges along rows with the double-incremental
+    /// scheme of §3.5 eq. 3 (same decisions as direct evaluation).
+    pub incremental: bool,
+}
+
+impl SampleOracles {
+    pub const BRUTE: SampleOracles = SampleOracles {
+        binning: false,
+        leaf: 8,
+        early_z: false,
+        incremental: false,
+    };
+    pub const BINNED: SampleOracles = SampleOracles {
+        binning: true,
+        leaf: 8,
+        early_z: true,
+        incremental: false,
+    };
+}
+
+/// The oracles of Fig. 7 for a BVH traversal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TraversalOracles {
+    /// Side of the initial frusta in pixels (each is one parallel work item).
+    pub frustum: u32,
+    /// `is_outside`: cull nodes outside the frustum.
+    pub outside: bool,
+    /// `is_occluded`: cull nodes behind the hierarchical w-buffer.
+    pub occluded: bool,
+    /// `split_frustum`: split down to this many pixels square (`None`: never).
+    pub split: Option<u32>,
+    /// `generate_samples` at leaves: how samples are enumerated.
+    pub samples: SampleOracles,
+}
+
+/// Which edge functions an all-triangles pipeline sets up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EdgeKind {
+    TwoD,
+    Homogeneous,
+    ThreeD,
+}
+
+/// A point of the continuum: how triangles and samples are enumerated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pipeline {
+    /// Every triangle, samples by bounding box or binning.
+    AllTriangles {
+        edges: EdgeKind,
+        samples: SampleOracles,
+    },
+    /// The Fig. 7 traversal of frusta through the BVH.
+    Frusta(TraversalOracles),
+    /// One ray per sample through the BVH.
+    Rays,
+    /// The GPU's hardware pipeline.
+    Gpu,
+}
+
+impl AlgorithmId {
+    /// The oracle settings that make this algorithm (paper §5).
+    pub fn pipeline(self) -> Pipeline {
+        let frusta = |outside, occluded, split, samples| {
+            Pipeline::Frusta(TraversalOracles {
+                frustum: 256,
+                outside,
+                occluded,
+                split,
+                samples,
+            })
+        };
+        let binning_only = SampleOracles {
+            early_z: false,
+            ..SampleOracles::BINNED
+        };
+        match self {
+            AlgorithmId::TwoDBrute => Pipeline::AllTriangles {
+                edges: EdgeKind::TwoD,
+                samples: SampleOracles::BRUTE,
+            },
+            AlgorithmId::TwoDBin => Pipeline::AllTriangles {
+                edges: EdgeKind::TwoD,
+                samples: SampleOracles::BINNED,
+            },
+            AlgorithmId::TwoDHomogeneous => Pipeline::AllTriangles {
+                edges: EdgeKind::Homogeneous,
+                samples: SampleOracles::BRUTE,
+            },
+            AlgorithmId::ThreeDBrute => Pipeline::AllTriangles {
+                edges: EdgeKind::ThreeD,
+                samples: SampleOracles::BRUTE,
+            },
+            AlgorithmId::ThreeDBin => Pipeline::AllTriangles {
+                edges: EdgeKind::ThreeD,
+                samples: SampleOracles::BINNED,
+            },
+            AlgorithmId::ThreeDFrustumCull => frusta(true, false, None, binning_only),
+            AlgorithmId::ThreeDFrustumSplit => frusta(true, true, Some(8), SampleOracles::BRUTE),
+            AlgorithmId::ThreeDFull => frusta(true, true, Some(8), SampleOracles::BINNED),
+            AlgorithmId::Raycast => Pipeline::Rays,
+            AlgorithmId::GpuRaster => Pipeline::Gpu,
+        }
+    }
+}
+
+impl Pipeline {
+    /// This pipeline with `oracles` set on top of its own. The traversal
+    /// keys need a BVH algorithm; the ray caster and the GPU take none.
+    pub fn with_oracles(self, oracles: &Oracles) -> Result<Pipeline, FieldError> {
+        if oracles.is_empty() {
+            return Ok(self);
+        }
+        let bad = |m: &str| FieldError::new("oracles", m);
+        let mut p = self;
+        let samples = match &mut p {
+            Pipeline::AllTriangles { samples, .. } => samples,
+            Pipeline::Frusta(t) => &mut t.samples,
+            Pipeline::Rays => return Err(bad("raycast takes no oracles")),
+            Pipeline::Gpu => return Err(bad("gpu-raster takes no oracles")),
+        };
+        let set = |to: &mut bool, v: Option<bool>| *to = v.unwrap_or(*to);
+        set(&mut samples.binning, oracles.binning);
+        set(&mut samples.incremental, oracles.incremental);
+        set(&mut samples.early_z, oracles.early_z);
+        samples.leaf = oracles.leaf.unwrap_or(samples.leaf);
+        let traversal = [
+            ("outside", oracles.outside.is_some()),
+            ("occluded", oracles.occluded.is_some()),
+            ("split", oracles.split.is_some()),
+            ("frustum", oracles.frustum.is_some()),
+        ];
+        match &mut p {
+            Pipeline::Frusta(t) => {
+                set(&mut t.outside, oracles.outside);
+                set(&mut t.occluded, oracles.occluded);
+                t.split = oracles.split.unwrap_or(t.split);
+                t.frustum = oracles.frustum.unwrap_or(t.frustum);
+            }
+            _ => {
+                if let Some((key, _)) = traversal.iter().find(|(_, given)| *given) {
+                    return Err(bad(&format!(
+                        "'{key}' needs a BVH algorithm (3dr-frustum-cull, 3dr-frustum-split, 3dr-full)"
+                    )));
+                }
+            }
+        }
+        Ok(p)
+    }
+
+    /// Does this pipeline take oracle settings at all?
+    pub fn takes_oracles(self) -> bool {
+        matches!(self, Pipeline::AllTriangles { .. } | Pipeline::Frusta(_))
+    }
+
+    /// Can this pipeline render `viewport`? Straight edges (the 2D family) and
+    /// planar frusta (the BVH traversal) need a planar viewport; 3D edge
+    /// functions over all triangles and the ray caster serve every viewport.
+    pub fn serves(self, viewport: &Viewport) -> bool {
+        viewport.is_planar()
+            || matches!(
+                self,
+                Pipeline::AllTriangles {
+                    edges: EdgeKind::ThreeD,
+                    ..
+                } | Pipeline::Rays
+            )
+    }
+
+    /// How samples are enumerated (`None` for the ray caster and the GPU).
+    pub fn samples(self) -> Option<SampleOracles> {
+        match self {
+            Pipeline::AllTriangles { samples, .. } => Some(samples),
+            Pipeline::Frusta(t) => Some(t.samples),
+            Pipeline::Rays | Pipeline::Gpu => None,
+        }
+    }
+
+    /// The paper's Fig. 10 scalar instruction costs: (setup, per sample); the
+    /// GPU's are not modelled (zero).
+    pub fn instruction_costs(self) -> (u64, u64) {
+        match self {
+            Pipeline::Gpu => (0, 0),
+            Pipeline::AllTriangles {
+                edges: EdgeKind::TwoD,
+                ..
+            } => (72, 14),
+            Pipeline::AllTriangles {
+                edges: EdgeKind::Homogeneous,
+                ..
+            } => (73, 14),
+            _ => (57, 12),
+        }
+    }
+}

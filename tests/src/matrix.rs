@@ -1,0 +1,183 @@
+//! The one test matrix: scenes × cameras × viewports × anti-aliasing modes ×
+//! precisions × algorithms, each cell rendered once if the renderer's
+//! capability check ([`continuum::check`]) says the algorithm serves it. A
+//! test states its matrix, gets every rendered cell, and learns how many
+//! there were (and a matrix that renders nothing fails), so no test passes
+//! by checking nothing.
+
+use continuum::{
+    AaMode, AlgorithmId, Camera, Family, Precision, PreparedScene, RenderOutput, RenderRequest,
+    Viewport, render,
+};
+
+use crate::{builtin_scenes, prepared};
+
+/// Which cameras of each scene a matrix renders through.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cameras {
+    /// The scene's first camera.
+    First,
+    /// Every camera the scene names.
+    All,
+    /// The scene's camera of this name.
+    Named(&'static str),
+}
+
+/// A matrix of renders; [`Matrix::new`] is every built-in scene's first
+/// camera, its own viewport, no anti-aliasing, f32, every CPU algorithm, at
+/// 64×48.
+#[derive(Clone, Debug)]
+pub struct Matrix {
+    pub scenes: Vec<String>,
+    pub cameras: Cameras,
+    /// `None`: the camera's own viewport.
+    pub viewports: Vec<Option<Viewport>>,
+    pub aa: Vec<AaMode>,
+    pub precisions: Vec<Precision>,
+    pub algorithms: Vec<AlgorithmId>,
+    pub size: (u32, u32),
+}
+
+/// One rendered cell.
+#[derive(Debug)]
+pub struct Cell<'a> {
+    pub scene: &'a str,
+    pub prepared: &'a PreparedScene,
+    pub request: &'a RenderRequest,
+    pub output: &'a RenderOutput,
+}
+
+impl Cell<'_> {
+    /// The cell without its algorithm, plus the algorithm's family: the key
+    /// under which renders must agree bit for bit.
+    pub fn family_key(&self) -> String {
+        let r = self.request;
+        format!(
+            "{} {} {} {} {} {:?}",
+            self.scene,
+            r.camera.name,
+            r.camera.viewport,
+            r.aa,
+            r.precision,
+            r.algorithm.family()
+        )
+    }
+
+    /// Names the cell in failure messages.
+    pub fn label(&self) -> String {
+        let r = self.request;
+        format!(
+            "{}/{} {} {} {} {}",
+            self.scene, r.camera.name, r.camera.viewport, r.aa, r.precision, r.algorithm
+        )
+    }
+
+    pub fn family(&self) -> Family {
+        self.request.algorithm.family()
+    }
+}
+
+impl Default for Matrix {
+    fn default() -> Matrix {
+        Matrix::new()
+    }
+}
+
+impl Matrix {
+    pub fn new() -> Matrix {
+        Matrix {
+            scenes: builtin_scenes(),
+            cameras: Cameras::First,
+            viewports: vec![None],
+            aa: vec![AaMode::None],
+            precisions: vec![Precision::F32],
+            algorithms: AlgorithmId::CPU.to_vec(),
+            size: (64, 48),
+        }
+    }
+
+    /// Renders every cell an algorithm serves, in order (scene, camera,
+    /// viewport, mode, precision, algorithm), handing each to `check`;
+    /// returns how many were rendered and fails when none was. Cells the
+    /// capability check refuses (an algorithm that does not serve the
+    /// viewport or precision, `gpu-raster` on see-through materials) are
+    /// left out; an algorithm this machine cannot run is a failure.
+    pub fn run(&self, mut check: impl FnMut(&Cell)) -> usize {
+        let mut rendered = 0;
+        for name in &self.scenes {
+            let scene = prepared(name);
+            let cameras: Vec<Camera> = match self.cameras {
+                Cameras::First => vec![scene.scene.first_camera()],
+                Cameras::All => scene.scene.cameras.clone(),
+                Cameras::Named(camera) => vec![
+                    scene
+                        .scene
+                        .camera(camera)
+                        .unwrap_or_else(|e| panic!("{name}: {e}")),
+                ],
+            };
+            for camera in &cameras {
+                for viewport in &self.viewports {
+                    let camera = Camera {
+                        viewport: viewport.unwrap_or(camera.viewport),
+                        ..camera.clone()
+                    };
+                    for &aa in &self.aa {
+                        for &precision in &self.precisions {
+                            for &algorithm in &self.algorithms {
+                                let (w, h) = self.size;
+                                let request = RenderRequest {
+                                    aa,
+                                    precision,
+                                    ..RenderRequest::new(algorithm, camera.clone(), w, h)
+                                };
+                                // A test needs what it names: an algorithm this
+                                // machine cannot run fails loudly, never skips.
+                                if let Some(why) = continuum::unavailable(algorithm) {
+                                    panic!("{algorithm} cannot run here: {why}");
+                                }
+                                if continuum::check(&request, Some(&scene)).is_err() {
+                                    continue;
+                                }
+                                let output = render(&scene, &request).unwrap_or_else(|e| {
+                                    panic!("{name}/{} {algorithm}: {e}", camera.name)
+                                });
+                                rendered += 1;
+                                check(&Cell {
+                                    scene: name,
+                                    prepared: &scene,
+                                    request: &request,
+                                    output: &output,
+                                });
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(rendered > 0, "the matrix rendered nothing: {self:?}");
+        rendered
+    }
+
+    /// Runs the matrix and asserts that within each family every algorithm
+    /// renders what the first one did (every buffer hash and the samples'
+    /// digest); returns how many renders were compared with a first one.
+    pub fn assert_families_agree(&self) -> usize {
+        let mut first: std::collections::HashMap<String, (String, continuum::Hashes)> =
+            std::collections::HashMap::new();
+        let mut compared = 0;
+        self.run(|cell| {
+            let hashes = cell.output.hashes.clone();
+            match first.get(&cell.family_key()) {
+                Some((label, h)) => {
+                    compared += 1;
+                    assert_eq!(h, &hashes, "{} differs from {label}", cell.label());
+                }
+                None => {
+                    first.insert(cell.family_key(), (cell.label(), hashes));
+                }
+            }
+        });
+        compared
+    }
+}
