@@ -29,16 +29,16 @@ mod simd;
 // Floor 1 — settings a request names.
 mod aa;
 mod color;
-mod pipeline;
 mod precision;
 mod viewport;
+mod pipeline;
 // Floor 2 — geometry and scenes.
 mod camera;
-mod clip;
-mod effects;
-mod request;
 pub mod scene;
+mod effects;
 mod texture;
+mod request;
+mod clip;
 // Floor 3 — edge functions.
 mod edge;
 // Floor 4 — the BVH.
@@ -46,26 +46,26 @@ mod bvh;
 // Floor 5 — the prepared scene.
 mod prepared;
 // Floor 6 — frame buffers, statistics, images of them, screen boxes.
+mod stats;
 mod framebuffer;
 pub mod maps;
 pub mod metrics;
 mod screen_boxes;
-mod stats;
 // Floor 7 — the stages: shading, binning, traversal, the anti-aliasing resolve.
-mod binning;
-mod resolve;
 mod shade;
+mod binning;
 mod traversal;
+mod resolve;
 // Floor 8 — the algorithms (the GPU's among them) and their one dispatch.
-mod algorithm;
 #[cfg(feature = "gpu")]
 mod gpu;
+mod algorithm;
 // Floor 9 — what may be rendered, the words a user types, the entry point;
 // kernels for benches and tests.
 mod capability;
-pub mod internal;
-mod render;
 mod words;
+mod render;
+pub mod internal;
 
 pub use aa::AaMode;
 pub use camera::{Camera, View, pixel_center};
