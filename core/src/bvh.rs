@@ -8,7 +8,7 @@
 //! boxes are padded (relative [`BOX_PAD`]) and zero direction components get an
 //! exact slab test.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use glam::{UVec2, Vec3, Vec3A};
 use obvhs::BvhBuildParams;
@@ -36,8 +36,6 @@ pub struct SceneBvh {
     pub cwbvh: CwBvh,
     /// Per node, its children's boxes in world space, padded by [`BOX_PAD`].
     pub child_boxes: Vec<ChildBoxes>,
-    /// Build wall time in milliseconds.
-    pub build_ms: f64,
 }
 
 /// Index of `node` in `bvh.nodes` (the traversal hands out references).
@@ -90,7 +88,6 @@ pub fn padded(min: Vec3A, max: Vec3A) -> (Vec3A, Vec3A) {
 impl SceneBvh {
     /// Builds over `triangles[id]` for every `id` in `drawable`.
     pub fn build(triangles: &[[Vec3; 3]], drawable: &[u32]) -> SceneBvh {
-        let start = Instant::now();
         let aabbs = primitive_aabbs(triangles, drawable);
         let cwbvh = if aabbs.is_empty() {
             CwBvh::default()
@@ -102,11 +99,7 @@ impl SceneBvh {
             )
         };
         let child_boxes = cwbvh.nodes.iter().map(decode_children).collect();
-        SceneBvh {
-            cwbvh,
-            child_boxes,
-            build_ms: start.elapsed().as_secs_f64() * 1e3,
-        }
+        SceneBvh { cwbvh, child_boxes }
     }
 
     /// Checks obvhs's structural invariants against the primitive boxes; panics on

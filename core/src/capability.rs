@@ -12,12 +12,17 @@ use crate::prepared::PreparedScene;
 use crate::request::RenderRequest;
 use crate::viewport::Viewport;
 
-/// The pipeline that renders `request`, or the first field that stops it:
+/// Whether `request` can be rendered here, or the first field that stops it:
 /// `size`, `camera`, `oracles`, `viewport`, `precision`, `aa`, then
 /// `algorithm` (what this machine cannot run, or — with `scene` — what the
 /// scene's materials rule out). Without a scene, the scene's part is left to
 /// the render.
-pub fn check(
+pub fn check(request: &RenderRequest, scene: Option<&PreparedScene>) -> Result<(), FieldError> {
+    pipeline_for(request, scene).map(|_| ())
+}
+
+/// [`check`], answering with the pipeline that renders the request.
+pub(crate) fn pipeline_for(
     request: &RenderRequest,
     scene: Option<&PreparedScene>,
 ) -> Result<Pipeline, FieldError> {

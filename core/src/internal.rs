@@ -3,6 +3,7 @@
 
 use crate::edge::Coverage;
 pub use crate::edge::Triangle3D;
+use crate::prepared::PreparedScene;
 pub use crate::shade::secondary::{Rays, intersect};
 pub use crate::simd::{Isa, cpu_has_avx2};
 use crate::simd::{Lanes, Portable};
@@ -20,6 +21,12 @@ pub fn covered_samples(triangles: &[Triangle3D], width: u32, height: u32, isa: I
         }
         Isa::Avx2 => None,
     }
+}
+
+/// Checks the scene's BVH against its triangles (every drawable triangle in
+/// exactly one leaf, every box holding its children); panics on a fault.
+pub fn validate_bvh(scene: &PreparedScene) {
+    scene.bvh.validate(&scene.triangles, &scene.drawable);
 }
 
 #[cfg(target_arch = "x86_64")]

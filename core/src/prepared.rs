@@ -20,19 +20,19 @@ pub struct PreparedScene {
     /// Vertex positions per triangle id.
     pub triangles: Vec<[Vec3; 3]>,
     /// Unit geometric normal per triangle id (zero for degenerate triangles).
-    pub face_normals: Vec<Vec3>,
+    pub(crate) face_normals: Vec<Vec3>,
     /// Ids of the triangles that are drawn: all but the degenerate ones (two equal
     /// vertices, or an f32 cross product of exactly zero).
     pub drawable: Vec<u32>,
-    pub bvh: SceneBvh,
+    pub(crate) bvh: SceneBvh,
     /// Triangle id of each BVH primitive slot: `drawable[primitive_indices[slot]]`,
     /// so per-slot data sits in the order leaves read it.
-    pub slot_triangles: Vec<u32>,
+    pub(crate) slot_triangles: Vec<u32>,
     /// Per slot: its triangle's positions and mesh vertex indices, so a
     /// per-view setup in slot order reads memory in order instead of
     /// gathering from the mesh.
-    pub slot_corners: Vec<[Vec3; 3]>,
-    pub slot_vertices: Vec<[u32; 3]>,
+    pub(crate) slot_corners: Vec<[Vec3; 3]>,
+    pub(crate) slot_vertices: Vec<[u32; 3]>,
     pub bounds: Bounds,
     /// Near distance for cameras that give none: 1e-3 of the bounding radius.
     pub default_near: f32,

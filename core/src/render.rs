@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use crate::algorithm;
 use crate::camera::View;
-use crate::capability::check;
+use crate::capability::pipeline_for;
 use crate::framebuffer::Framebuffer;
 use crate::ground::{AlgorithmId, FieldError};
 use crate::precision::Precision;
@@ -79,7 +79,7 @@ pub fn render_cancellable(
     cancel: &AtomicBool,
 ) -> Result<RenderOutput, FieldError> {
     let total = Instant::now();
-    let pipeline = check(request, Some(scene))?;
+    let pipeline = pipeline_for(request, Some(scene))?;
     let view = View::new(
         &request.camera,
         request.width,

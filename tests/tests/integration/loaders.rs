@@ -184,7 +184,7 @@ fn builtin_scenes_load_with_cameras_and_a_valid_bvh() {
     for name in &names {
         let p = prepared(name);
         assert!(p.scene.cameras.len() >= 2, "{name}");
-        p.bvh.validate(&p.triangles, &p.drawable);
+        continuum::internal::validate_bvh(&p);
     }
     assert!(prepared("teapots").triangle_count() >= 1_000_000);
     assert_eq!(prepared("bunny").triangle_count(), 69_451);
