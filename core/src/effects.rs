@@ -191,7 +191,7 @@ pub struct EffectStats {
 
 impl Scene {
     /// The effects this scene calls for, from the scene alone (the
-    /// [`EffectPlan`]'s words): `textures`,
+    /// effect plan's words): `textures`,
     /// `shadows`, `reflections`, `transparency`.
     pub fn effects(&self) -> Vec<&'static str> {
         EffectPlan::of(self).names()

@@ -207,9 +207,9 @@ mod avx2_lanes {
 /// The instruction sets the kernels can run on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Isa {
-    /// [`Portable`] lanes.
+    /// The portable lanes (`wide`).
     Portable,
-    /// [`Avx2`] lanes (x86-64 CPUs that have AVX2).
+    /// AVX2 lanes (x86-64 CPUs that have AVX2).
     Avx2,
 }
 

@@ -175,7 +175,7 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
         {
             self.counters.frusta_split += 1;
             // The first halves take the middle pixel of an odd side.
-            let (mx, my) = ((f.x0 + f.x1 + 1) / 2, (f.y0 + f.y1 + 1) / 2);
+            let (mx, my) = ((f.x0 + f.x1).div_ceil(2), (f.y0 + f.y1).div_ceil(2));
             for q in [
                 PixelRect::new(f.x0, f.y0, mx, my),
                 PixelRect::new(mx, f.y0, f.x1, my),

@@ -45,7 +45,7 @@ pub(crate) const EPS: f32 = f32::EPSILON * 0.5;
 /// terms ~10⁵× larger): on 1M-triangle scenes that gave `w` errors of 0.1%.
 ///
 /// Every algorithm of the 3D family and the ray caster decide coverage and depth
-/// through [`Coverage::sample`] on these coefficients, in one fixed operation
+/// through `Coverage::sample` on these coefficients, in one fixed operation
 /// order with no fused multiply-add, so they agree bit for bit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Triangle3D<'a> {
