@@ -125,17 +125,6 @@ pub fn render_full(
     .unwrap_or_else(|e| panic!("{algorithm} {aa} {precision}: {e}"))
 }
 
-/// Does `algorithm` serve `viewport`? What the renderer's capability check
-/// does not blame the viewport for.
-pub fn serves(algorithm: AlgorithmId, viewport: continuum::Viewport) -> bool {
-    let camera = Camera {
-        viewport,
-        ..Camera::framing(&continuum::Bounds::EMPTY)
-    };
-    continuum::check(&RenderRequest::new(algorithm, camera, 8, 8), None)
-        .map_or_else(|e| e.field != "viewport", |_| true)
-}
-
 /// Pixels where two triangle-id buffers differ, as `(x, y, a, b)`.
 pub fn id_differences(a: &RenderOutput, b: &RenderOutput) -> Vec<(u32, u32, u32, u32)> {
     let w = a.framebuffer.width;

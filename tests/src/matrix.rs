@@ -6,8 +6,8 @@
 //! by checking nothing.
 
 use continuum::{
-    AaMode, AlgorithmId, Camera, Family, Precision, PreparedScene, RenderOutput, RenderRequest,
-    Viewport, render,
+    AaMode, AlgorithmId, Camera, Family, Oracles, Precision, PreparedScene, RenderOutput,
+    RenderRequest, Viewport, render,
 };
 
 use crate::{builtin_scenes, prepared};
@@ -23,18 +23,45 @@ pub enum Cameras {
     Named(&'static str),
 }
 
+/// Which viewport a cell looks through.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ViewportChoice {
+    /// The camera's own.
+    Own,
+    /// This one.
+    Is(Viewport),
+    /// Orthographic, framing what the camera shows at its target
+    /// ([`orthographic_for`]).
+    Orthographic,
+}
+
+/// An orthographic view that frames what a perspective camera frames at its
+/// target (a 60° field of view standing in for other cameras').
+pub fn orthographic_for(camera: &Camera) -> Viewport {
+    let fov = match camera.viewport {
+        Viewport::Perspective { fov_y_deg } => fov_y_deg,
+        _ => 60.0,
+    };
+    let distance = (camera.target - camera.eye).length();
+    Viewport::Orthographic {
+        height: 2.0 * distance * (fov.to_radians() * 0.5).tan(),
+    }
+}
+
 /// A matrix of renders; [`Matrix::new`] is every built-in scene's first
-/// camera, its own viewport, no anti-aliasing, f32, every CPU algorithm, at
-/// 64×48.
+/// camera, its own viewport, no anti-aliasing, f32, every CPU algorithm with
+/// its own oracle settings, at 64×48.
 #[derive(Clone, Debug)]
 pub struct Matrix {
     pub scenes: Vec<String>,
     pub cameras: Cameras,
-    /// `None`: the camera's own viewport.
-    pub viewports: Vec<Option<Viewport>>,
+    pub viewports: Vec<ViewportChoice>,
     pub aa: Vec<AaMode>,
     pub precisions: Vec<Precision>,
     pub algorithms: Vec<AlgorithmId>,
+    /// Oracle settings each algorithm is rendered with (cells whose settings
+    /// the algorithm does not take are left out).
+    pub oracles: Vec<Oracles>,
     pub size: (u32, u32),
 }
 
@@ -48,8 +75,8 @@ pub struct Cell<'a> {
 }
 
 impl Cell<'_> {
-    /// The cell without its algorithm, plus the algorithm's family: the key
-    /// under which renders must agree bit for bit.
+    /// The cell without its algorithm and oracles, plus the algorithm's
+    /// family: the key under which renders must agree bit for bit.
     pub fn family_key(&self) -> String {
         let r = self.request;
         format!(
@@ -67,8 +94,8 @@ impl Cell<'_> {
     pub fn label(&self) -> String {
         let r = self.request;
         format!(
-            "{}/{} {} {} {} {}",
-            self.scene, r.camera.name, r.camera.viewport, r.aa, r.precision, r.algorithm
+            "{}/{} {} {} {} {} {}",
+            self.scene, r.camera.name, r.camera.viewport, r.aa, r.precision, r.algorithm, r.oracles
         )
     }
 
@@ -88,16 +115,17 @@ impl Matrix {
         Matrix {
             scenes: builtin_scenes(),
             cameras: Cameras::First,
-            viewports: vec![None],
+            viewports: vec![ViewportChoice::Own],
             aa: vec![AaMode::None],
             precisions: vec![Precision::F32],
             algorithms: AlgorithmId::CPU.to_vec(),
+            oracles: vec![Oracles::default()],
             size: (64, 48),
         }
     }
 
     /// Renders every cell an algorithm serves, in order (scene, camera,
-    /// viewport, mode, precision, algorithm), handing each to `check`;
+    /// viewport, mode, precision, algorithm, oracles), handing each to `check`;
     /// returns how many were rendered and fails when none was. Cells the
     /// capability check refuses (an algorithm that does not serve the
     /// viewport or precision, `gpu-raster` on see-through materials) are
@@ -117,18 +145,28 @@ impl Matrix {
                 ],
             };
             for camera in &cameras {
-                for viewport in &self.viewports {
+                for choice in &self.viewports {
+                    let viewport = match *choice {
+                        ViewportChoice::Own => camera.viewport,
+                        ViewportChoice::Is(v) => v,
+                        ViewportChoice::Orthographic => orthographic_for(camera),
+                    };
                     let camera = Camera {
-                        viewport: viewport.unwrap_or(camera.viewport),
+                        viewport,
                         ..camera.clone()
                     };
                     for &aa in &self.aa {
                         for &precision in &self.precisions {
-                            for &algorithm in &self.algorithms {
+                            for (&algorithm, &oracles) in self
+                                .algorithms
+                                .iter()
+                                .flat_map(|a| self.oracles.iter().map(move |o| (a, o)))
+                            {
                                 let (w, h) = self.size;
                                 let request = RenderRequest {
                                     aa,
                                     precision,
+                                    oracles,
                                     ..RenderRequest::new(algorithm, camera.clone(), w, h)
                                 };
                                 // A test needs what it names: an algorithm this

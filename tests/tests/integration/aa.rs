@@ -4,7 +4,7 @@
 //! promises.
 
 use continuum::{AaMode, AlgorithmId, Viewport};
-use continuum_tests::matrix::Matrix;
+use continuum_tests::matrix::{Matrix, ViewportChoice};
 use continuum_tests::{exact_camera, pixel_point, prepared, render_aa, scene_from_triangles};
 use glam::{DVec2, Vec3};
 
@@ -194,7 +194,7 @@ fn algorithms_agree_per_sample() {
     assert!(compared >= 12 * 3 * 6, "only {compared} comparisons");
     let parabolic = Matrix {
         scenes: vec!["teapots".into()],
-        viewports: vec![Some(Viewport::Parabolic)],
+        viewports: vec![ViewportChoice::Is(Viewport::Parabolic)],
         ..every_scene
     };
     // 3dr-brute, 3dr-bin and raycast serve the parabolic viewport.

@@ -3,43 +3,24 @@
 //! sample to binning, closed meshes stay watertight on curved viewports, and the
 //! golden images of `teapots` hold.
 
-use continuum::{AlgorithmId, Camera, Family, RenderOutput, RenderRequest, Viewport, render};
-use continuum_tests::golden::assert_golden;
-use continuum_tests::{
-    builtin_scenes, explain_2d_3d, id_differences, prepared, render_with, render_with_oracles,
-    serves,
+use std::collections::HashMap;
+
+use continuum::{
+    AlgorithmId, Camera, Family, Oracles, RenderOutput, RenderRequest, Viewport, render,
 };
+use continuum_tests::golden::assert_golden;
+use continuum_tests::matrix::{Cameras, Matrix, ViewportChoice, orthographic_for};
+use continuum_tests::{explain_2d_3d, id_differences, prepared, render_with};
 use glam::Vec3;
 
 const W: u32 = 192;
 const H: u32 = 96;
-
-/// An orthographic view that frames what the perspective camera frames at its target.
-fn orthographic_for(camera: &Camera) -> Viewport {
-    let fov = match camera.viewport {
-        Viewport::Perspective { fov_y_deg } => fov_y_deg,
-        _ => 60.0,
-    };
-    let distance = (camera.target - camera.eye).length();
-    Viewport::Orthographic {
-        height: 2.0 * distance * (fov.to_radians() * 0.5).tan(),
-    }
-}
 
 fn with_viewport(camera: &Camera, viewport: Viewport) -> Camera {
     Camera {
         viewport,
         ..camera.clone()
     }
-}
-
-/// The three viewports beyond the pinhole, for `camera`.
-fn other_viewports(camera: &Camera) -> [Viewport; 3] {
-    [
-        orthographic_for(camera),
-        Viewport::Parabolic,
-        Viewport::LatLong,
-    ]
 }
 
 fn assert_identical(what: &str, a: &RenderOutput, b: &RenderOutput) {
@@ -60,47 +41,46 @@ fn assert_identical(what: &str, a: &RenderOutput, b: &RenderOutput) {
 /// triangle ids and depths bit for bit.
 #[test]
 fn three_d_family_and_raycast_agree_on_every_viewport() {
+    let three_d: Vec<AlgorithmId> = AlgorithmId::CPU
+        .into_iter()
+        .filter(|a| a.family() == Family::ThreeD)
+        .collect();
+    // Binning without early-z: every curved block test is exercised.
+    let binning_only = Oracles::parse("early_z=off").expect("valid words");
+    let mut first: HashMap<String, RenderOutput> = HashMap::new();
     let mut compared = 0;
-    for name in builtin_scenes() {
-        let scene = prepared(&name);
-        for camera in &scene.scene.cameras {
-            for viewport in other_viewports(camera) {
-                let camera = with_viewport(camera, viewport);
-                let what = format!("{name}/{} {viewport}", camera.name);
-                let reference = render_with(&scene, AlgorithmId::ThreeDBrute, &camera, W, H);
-                let covered = reference
-                    .framebuffer
-                    .triangle_id
-                    .iter()
-                    .filter(|&&id| id != continuum::BACKGROUND)
-                    .count();
-                assert!(covered > 0, "{what}: nothing drawn");
-                let served = AlgorithmId::CPU
-                    .into_iter()
-                    .filter(|&a| a.family() == Family::ThreeD && serves(a, viewport));
-                for algorithm in served.skip(1) {
-                    let out = render_with(&scene, algorithm, &camera, W, H);
-                    assert_identical(&what, &reference, &out);
-                    compared += 1;
-                }
-                // Binning without early-z: every curved block test is exercised.
-                let binned = render_with_oracles(
-                    &scene,
-                    AlgorithmId::ThreeDBin,
-                    Some("early_z=off"),
-                    &camera,
-                    W,
-                    H,
-                );
-                assert_identical(&format!("{what} binning only"), &reference, &binned);
-                assert_eq!(
-                    binned.framebuffer.coverage_writes, reference.framebuffer.coverage_writes,
-                    "{what}: binning lost or added a covered sample"
-                );
-                compared += 1;
-            }
-        }
+    Matrix {
+        cameras: Cameras::All,
+        viewports: vec![
+            ViewportChoice::Orthographic,
+            ViewportChoice::Is(Viewport::Parabolic),
+            ViewportChoice::Is(Viewport::LatLong),
+        ],
+        algorithms: three_d,
+        oracles: vec![Oracles::default(), binning_only],
+        size: (W, H),
+        ..Matrix::new()
     }
+    .run(|cell| {
+        let Some(reference) = first.get(&cell.family_key()) else {
+            let drawn = cell.output.framebuffer.triangle_id.iter();
+            let covered = drawn.filter(|&&id| id != continuum::BACKGROUND).count();
+            assert!(covered > 0, "{}: nothing drawn", cell.label());
+            first.insert(cell.family_key(), cell.output.clone());
+            return;
+        };
+        assert_identical(&cell.label(), reference, cell.output);
+        if cell.request.algorithm == AlgorithmId::ThreeDBin && cell.request.oracles == binning_only
+        {
+            assert_eq!(
+                cell.output.framebuffer.coverage_writes,
+                reference.framebuffer.coverage_writes,
+                "{}: binning lost or added a covered sample",
+                cell.label()
+            );
+        }
+        compared += 1;
+    });
     assert!(compared >= 7 * 2 * 9, "only {compared} comparisons");
 }
 
@@ -108,32 +88,54 @@ fn three_d_family_and_raycast_agree_on_every_viewport() {
 /// and against 3dr-brute every differing pixel explained in f64.
 #[test]
 fn two_d_families_serve_orthographic_views() {
-    let (mut covered, mut differing) = (0, 0);
-    for name in builtin_scenes() {
-        let scene = prepared(&name);
-        for camera in &scene.scene.cameras {
-            let camera = with_viewport(camera, orthographic_for(camera));
-            let what = format!("{name}/{} {}", camera.name, camera.viewport);
-            let three = render_with(&scene, AlgorithmId::ThreeDBrute, &camera, W, H);
-            let two = render_with(&scene, AlgorithmId::TwoDBrute, &camera, W, H);
-            let binned = render_with(&scene, AlgorithmId::TwoDBin, &camera, W, H);
-            assert_identical(&what, &two, &binned);
-            for other in [
-                two,
-                render_with(&scene, AlgorithmId::TwoDHomogeneous, &camera, W, H),
-            ] {
-                let r = explain_2d_3d(&scene, &other, &three);
+    let (mut covered, mut differing, mut explained) = (0, 0, 0);
+    let mut three: Option<RenderOutput> = None;
+    let mut two: Option<RenderOutput> = None;
+    let rendered = Matrix {
+        cameras: Cameras::All,
+        viewports: vec![ViewportChoice::Orthographic],
+        algorithms: vec![
+            AlgorithmId::ThreeDBrute,
+            AlgorithmId::TwoDBrute,
+            AlgorithmId::TwoDBin,
+            AlgorithmId::TwoDHomogeneous,
+        ],
+        size: (W, H),
+        ..Matrix::new()
+    }
+    .run(|cell| {
+        let out = cell.output;
+        match cell.request.algorithm {
+            AlgorithmId::ThreeDBrute => three = Some(out.clone()),
+            AlgorithmId::TwoDBin => {
+                let two = two.as_ref().expect("2dr-brute renders before 2dr-bin");
+                assert_identical(&cell.label(), two, out);
+            }
+            _ => {
+                let three = three.as_ref().expect("3dr-brute renders first");
+                let r = explain_2d_3d(cell.prepared, out, three);
                 assert!(
                     r.unexplained.is_empty(),
-                    "{what} {}: unexplained differences {:?}",
-                    other.algorithm,
+                    "{}: unexplained differences {:?}",
+                    cell.label(),
                     &r.unexplained[..r.unexplained.len().min(10)]
                 );
                 covered += r.covered;
                 differing += r.explained();
+                explained += 1;
+                if cell.request.algorithm == AlgorithmId::TwoDBrute {
+                    two = Some(out.clone());
+                }
             }
         }
-    }
+    });
+    // 12 scenes, two cameras or more each, four algorithms.
+    assert!(rendered >= 12 * 2 * 4, "only {rendered} renders");
+    assert_eq!(
+        explained * 2,
+        rendered,
+        "two 2D renders explained per camera"
+    );
     println!("orthographic, 2D families vs 3D: {differing} of {covered} covered pixels differ");
     assert!(
         differing * 10_000 <= covered,
@@ -144,29 +146,34 @@ fn two_d_families_serve_orthographic_views() {
 /// The §3.5 double-incremental scheme decides every sample as direct evaluation does.
 #[test]
 fn incremental_evaluation_decides_like_direct_evaluation() {
-    for name in builtin_scenes() {
-        let scene = prepared(&name);
-        for camera in &scene.scene.cameras {
-            let camera = with_viewport(camera, Viewport::Parabolic);
-            for algorithm in [AlgorithmId::ThreeDBrute, AlgorithmId::ThreeDBin] {
-                let what = format!("{name}/{} {algorithm}", camera.name);
-                let direct = render_with(&scene, algorithm, &camera, 128, 128);
-                let incremental = render_with_oracles(
-                    &scene,
-                    algorithm,
-                    Some("incremental=on"),
-                    &camera,
-                    128,
-                    128,
-                );
-                assert_identical(&what, &direct, &incremental);
-                assert_eq!(
-                    direct.framebuffer.coverage_writes, incremental.framebuffer.coverage_writes,
-                    "{what}: coverage decisions differ"
-                );
-            }
-        }
+    let incremental = Oracles::parse("incremental=on").expect("valid words");
+    let mut direct: Option<RenderOutput> = None;
+    let mut compared = 0;
+    Matrix {
+        cameras: Cameras::All,
+        viewports: vec![ViewportChoice::Is(Viewport::Parabolic)],
+        algorithms: vec![AlgorithmId::ThreeDBrute, AlgorithmId::ThreeDBin],
+        oracles: vec![Oracles::default(), incremental],
+        size: (128, 128),
+        ..Matrix::new()
     }
+    .run(|cell| {
+        if cell.request.oracles != incremental {
+            direct = Some(cell.output.clone());
+            return;
+        }
+        let direct = direct.as_ref().expect("the direct render comes first");
+        assert_eq!(direct.algorithm, cell.request.algorithm);
+        assert_identical(&cell.label(), direct, cell.output);
+        assert_eq!(
+            direct.framebuffer.coverage_writes,
+            cell.output.framebuffer.coverage_writes,
+            "{}: coverage decisions differ",
+            cell.label()
+        );
+        compared += 1;
+    });
+    assert!(compared >= 12 * 2 * 2, "only {compared} comparisons");
     let scene = prepared("box");
     let camera = with_viewport(&scene.scene.first_camera(), Viewport::LatLong);
     let e = render(
