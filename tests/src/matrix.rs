@@ -19,6 +19,8 @@ pub enum Cameras {
     First,
     /// Every camera the scene names.
     All,
+    /// Every camera the scene names and the framing `default` one.
+    AllAndDefault,
     /// The scene's camera of this name.
     Named(&'static str),
 }
@@ -137,6 +139,7 @@ impl Matrix {
             let cameras: Vec<Camera> = match self.cameras {
                 Cameras::First => vec![scene.scene.first_camera()],
                 Cameras::All => scene.scene.cameras.clone(),
+                Cameras::AllAndDefault => scene.scene.all_cameras(),
                 Cameras::Named(camera) => vec![
                     scene
                         .scene

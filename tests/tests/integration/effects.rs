@@ -6,6 +6,7 @@ use continuum::internal::{Rays, intersect};
 use continuum::metrics::flip_mean;
 use continuum::scene::Scene;
 use continuum::{AaMode, AlgorithmId, Family, PreparedScene, RenderRequest};
+use continuum_tests::matrix::{Cameras, Matrix};
 use continuum_tests::{builtin_scenes, prepared, render_with};
 use glam::Vec3;
 
@@ -95,42 +96,43 @@ fn turning_one_lights_shadows_off_removes_exactly_its_rays() {
 
 #[test]
 fn every_algorithm_shades_the_same_image_with_effects() {
-    for name in EFFECT_SCENES {
-        let scene = prepared(name);
-        for camera in scene.scene.all_cameras() {
-            let reference = render_with(&scene, AlgorithmId::ThreeDBrute, &camera, SIZE.0, SIZE.1);
-            assert!(!reference.stats.effects.is_empty(), "{name}");
-            for algorithm in AlgorithmId::CPU
-                .into_iter()
-                .filter(|a| a.family() == Family::ThreeD)
-            {
-                let out = render_with(&scene, algorithm, &camera, SIZE.0, SIZE.1);
-                assert_eq!(
-                    out.hashes.triangle_id, reference.hashes.triangle_id,
-                    "{name}/{} {algorithm}",
-                    camera.name
-                );
-                assert_eq!(
-                    out.hashes.color, reference.hashes.color,
-                    "{name}/{} {algorithm}",
-                    camera.name
-                );
-                let counts = |o: &continuum::RenderOutput| {
-                    o.stats
-                        .effects
-                        .iter()
-                        .map(|e| (e.rays, e.lookups, e.texel_probes, e.fragments))
-                        .collect::<Vec<_>>()
-                };
-                assert_eq!(
-                    counts(&out),
-                    counts(&reference),
-                    "{name}/{} {algorithm}",
-                    camera.name
-                );
-            }
-        }
+    let counts = |o: &continuum::RenderOutput| {
+        o.stats
+            .effects
+            .iter()
+            .map(|e| (e.rays, e.lookups, e.texel_probes, e.fragments))
+            .collect::<Vec<_>>()
+    };
+    let mut reference: Option<continuum::RenderOutput> = None;
+    let three_d = AlgorithmId::CPU
+        .into_iter()
+        .filter(|a| a.family() == Family::ThreeD);
+    let rendered = Matrix {
+        scenes: EFFECT_SCENES.map(String::from).to_vec(),
+        cameras: Cameras::AllAndDefault,
+        algorithms: three_d.collect(),
+        size: SIZE,
+        ..Matrix::new()
     }
+    .run(|cell| {
+        let out = cell.output;
+        if cell.request.algorithm == AlgorithmId::ThreeDBrute {
+            assert!(!out.stats.effects.is_empty(), "{}", cell.label());
+            reference = Some(out.clone());
+            return;
+        }
+        let reference = reference.as_ref().expect("3dr-brute renders first");
+        assert_eq!(
+            out.hashes.triangle_id,
+            reference.hashes.triangle_id,
+            "{}",
+            cell.label()
+        );
+        assert_eq!(out.hashes.color, reference.hashes.color, "{}", cell.label());
+        assert_eq!(counts(out), counts(reference), "{}", cell.label());
+    });
+    // Five scenes, three cameras or more each (theirs and the default), six 3D algorithms.
+    assert!(rendered >= 5 * 3 * 6, "only {rendered} renders");
 }
 
 #[test]
