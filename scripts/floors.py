@@ -4,7 +4,7 @@
   scripts/floors.py [CRATE_SRC_DIR ...]   (default: every crate of the workspace)
 
 For every crate: the graph of its modules, an edge for each `crate::a::b` path and
-`use super::x` in non-test code (comments and `#[cfg(test)]` items left out), and
+`use super::x` in non-test code and doc comments (`#[cfg(test)]` items left out), and
 every cycle in it. For a crate whose lib.rs says `// floors:` (core), also the
 floor rule: a top-level module may import only modules declared before it in
 lib.rs, so lib.rs's order is the order of the floors."""
@@ -17,9 +17,10 @@ CRATES = ["core/src", "hardcases/src", "server/src", "viewer/src", "tests/src"]
 
 
 def strip(text):
-    """Non-test code without comments (string contents are kept; paths in
-    strings are rare and would only add edges)."""
-    text = re.sub(r"//[^\n]*", "", text)
+    """Non-test code without plain comments. Doc comments stay: an intra-doc
+    link to a module above is a reference up the floors too (string contents
+    are kept as well; paths in strings are rare and would only add edges)."""
+    text = re.sub(r"//(?![/!])[^\n]*", "", text)
     text = re.sub(r"/\*.*?\*/", "", text, flags=re.S)
     # Drop each `#[cfg(test)]` item: the attribute, then up to its matching brace.
     out, i = [], 0

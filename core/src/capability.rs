@@ -1,6 +1,6 @@
 //! Floor 9: the one answer to "can this request be rendered here?" —
 //! algorithm × viewport × precision × anti-aliasing × oracles × the scene's
-//! effects × this machine — with the field at fault. [`crate::render`] asks
+//! effects × this machine — with the field at fault. `render` asks
 //! it first; the service asks it before queueing a render, the viewer before
 //! starting one, and `/api/algorithms` builds its listing from it.
 

@@ -1,5 +1,5 @@
 //! Floor 2: a render request, typed — what every front end's words become
-//! (through [`crate::RenderWords`]) and what [`crate::render()`] takes.
+//! (through `RenderWords`) and what `render` takes.
 
 use crate::aa::AaMode;
 use crate::camera::Camera;
@@ -9,7 +9,7 @@ use crate::precision::Precision;
 use crate::texture::TextureFilter;
 
 /// What to render: which algorithm, from where, at what size. Front ends
-/// make one from a user's words through [`crate::RenderWords`]; code makes
+/// make one from a user's words through `RenderWords`; code makes
 /// one with [`RenderRequest::new`] and changes the fields it cares about.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderRequest {

@@ -154,7 +154,7 @@ impl Settings {
 
     /// A request that stands for these settings before a scene is at hand:
     /// the explicit camera if one is given, else a camera at the origin. What
-    /// [`crate::check`] says of it holds for every scene but the scene's own
+    /// `check` says of it holds for every scene but the scene's own
     /// part (see-through materials; a named camera's existence).
     pub fn probe(&self) -> Result<RenderRequest, FieldError> {
         let mut camera = match &self.camera {
