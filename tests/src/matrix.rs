@@ -133,70 +133,92 @@ impl Matrix {
     /// viewport or precision, `gpu-raster` on see-through materials) are
     /// left out; an algorithm this machine cannot run is a failure.
     pub fn run(&self, mut check: impl FnMut(&Cell)) -> usize {
+        let rendered: usize = self
+            .scenes
+            .iter()
+            .map(|name| self.render_scene(name, &prepared(name), &mut check))
+            .sum();
+        assert!(rendered > 0, "the matrix rendered nothing: {self:?}");
+        rendered
+    }
+
+    /// [`Matrix::run`] on one scene a test built itself (named `name` in
+    /// messages) instead of [`Matrix::scenes`].
+    pub fn run_on(&self, name: &str, scene: &PreparedScene, mut check: impl FnMut(&Cell)) -> usize {
+        let rendered = self.render_scene(name, scene, &mut check);
+        assert!(
+            rendered > 0,
+            "the matrix rendered nothing of {name}: {self:?}"
+        );
+        rendered
+    }
+
+    fn render_scene(
+        &self,
+        name: &str,
+        scene: &PreparedScene,
+        check: &mut impl FnMut(&Cell),
+    ) -> usize {
         let mut rendered = 0;
-        for name in &self.scenes {
-            let scene = prepared(name);
-            let cameras: Vec<Camera> = match self.cameras {
-                Cameras::First => vec![scene.scene.first_camera()],
-                Cameras::All => scene.scene.cameras.clone(),
-                Cameras::AllAndDefault => scene.scene.all_cameras(),
-                Cameras::Named(camera) => vec![
-                    scene
-                        .scene
-                        .camera(camera)
-                        .unwrap_or_else(|e| panic!("{name}: {e}")),
-                ],
-            };
-            for camera in &cameras {
-                for choice in &self.viewports {
-                    let viewport = match *choice {
-                        ViewportChoice::Own => camera.viewport,
-                        ViewportChoice::Is(v) => v,
-                        ViewportChoice::Orthographic => orthographic_for(camera),
-                    };
-                    let camera = Camera {
-                        viewport,
-                        ..camera.clone()
-                    };
-                    for &aa in &self.aa {
-                        for &precision in &self.precisions {
-                            for (&algorithm, &oracles) in self
-                                .algorithms
-                                .iter()
-                                .flat_map(|a| self.oracles.iter().map(move |o| (a, o)))
-                            {
-                                let (w, h) = self.size;
-                                let request = RenderRequest {
-                                    aa,
-                                    precision,
-                                    oracles,
-                                    ..RenderRequest::new(algorithm, camera.clone(), w, h)
-                                };
-                                // A test needs what it names: an algorithm this
-                                // machine cannot run fails loudly, never skips.
-                                if let Some(why) = continuum::unavailable(algorithm) {
-                                    panic!("{algorithm} cannot run here: {why}");
-                                }
-                                if continuum::check(&request, Some(&scene)).is_err() {
-                                    continue;
-                                }
-                                let output = render(&scene, &request).unwrap_or_else(|e| {
-                                    panic!("{name}/{} {algorithm}: {e}", camera.name)
-                                });
-                                rendered += 1;
-                                check(&Cell {
-                                    scene: name,
-                                    prepared: &scene,
-                                    request: &request,
-                                    output: &output,
-                                });
+        let cameras: Vec<Camera> = match self.cameras {
+            Cameras::First => vec![scene.scene.first_camera()],
+            Cameras::All => scene.scene.cameras.clone(),
+            Cameras::AllAndDefault => scene.scene.all_cameras(),
+            Cameras::Named(camera) => vec![
+                scene
+                    .scene
+                    .camera(camera)
+                    .unwrap_or_else(|e| panic!("{name}: {e}")),
+            ],
+        };
+        for camera in &cameras {
+            for choice in &self.viewports {
+                let viewport = match *choice {
+                    ViewportChoice::Own => camera.viewport,
+                    ViewportChoice::Is(v) => v,
+                    ViewportChoice::Orthographic => orthographic_for(camera),
+                };
+                let camera = Camera {
+                    viewport,
+                    ..camera.clone()
+                };
+                for &aa in &self.aa {
+                    for &precision in &self.precisions {
+                        for (&algorithm, &oracles) in self
+                            .algorithms
+                            .iter()
+                            .flat_map(|a| self.oracles.iter().map(move |o| (a, o)))
+                        {
+                            let (w, h) = self.size;
+                            let request = RenderRequest {
+                                aa,
+                                precision,
+                                oracles,
+                                ..RenderRequest::new(algorithm, camera.clone(), w, h)
+                            };
+                            // A test needs what it names: an algorithm this
+                            // machine cannot run fails loudly, never skips.
+                            if let Some(why) = continuum::unavailable(algorithm) {
+                                panic!("{algorithm} cannot run here: {why}");
                             }
+                            if continuum::check(&request, Some(scene)).is_err() {
+                                continue;
+                            }
+                            let output = render(scene, &request).unwrap_or_else(|e| {
+                                panic!("{name}/{} {algorithm}: {e}", camera.name)
+                            });
+                            rendered += 1;
+                            check(&Cell {
+                                scene: name,
+                                prepared: scene,
+                                request: &request,
+                                output: &output,
+                            });
                         }
                     }
                 }
             }
         }
-        assert!(rendered > 0, "the matrix rendered nothing: {self:?}");
         rendered
     }
 

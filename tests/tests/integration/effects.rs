@@ -500,30 +500,37 @@ fn blending_does_not_depend_on_drawing_order() {
 
 #[test]
 fn transparency_agrees_across_the_3d_family_with_anti_aliasing() {
-    let pane = prepared("pane");
-    let camera = pane.scene.first_camera();
-    for aa in [
+    let modes = [
         AaMode::Ssaa(4),
         AaMode::Msaa(4),
         AaMode::Csaa {
             coverage: 8,
             stored: 4,
         },
-    ] {
-        let reference =
-            continuum_tests::render_aa(&pane, AlgorithmId::ThreeDBrute, &camera, SIZE, aa);
-        for algorithm in AlgorithmId::CPU
+    ];
+    let mut reference: Option<continuum::RenderOutput> = None;
+    let rendered = Matrix {
+        scenes: vec!["pane".into()],
+        aa: modes.to_vec(),
+        algorithms: AlgorithmId::CPU
             .into_iter()
             .filter(|a| a.family() == Family::ThreeD)
-        {
-            let out = continuum_tests::render_aa(&pane, algorithm, &camera, SIZE, aa);
-            assert_eq!(out.hashes.color, reference.hashes.color, "{algorithm} {aa}");
-            assert_eq!(
-                out.framebuffer.blended, reference.framebuffer.blended,
-                "{algorithm} {aa}"
-            );
-        }
+            .collect(),
+        size: SIZE,
+        ..Matrix::new()
     }
+    .run(|cell| {
+        let out = cell.output;
+        if cell.request.algorithm == AlgorithmId::ThreeDBrute {
+            reference = Some(out.clone());
+            return;
+        }
+        let reference = reference.as_ref().expect("3dr-brute renders first");
+        assert_eq!(out.hashes.color, reference.hashes.color, "{}", cell.label());
+        let blended = &out.framebuffer.blended;
+        assert_eq!(blended, &reference.framebuffer.blended, "{}", cell.label());
+    });
+    assert_eq!(rendered, modes.len() * 6, "three modes, six 3D algorithms");
 }
 
 #[test]
@@ -682,32 +689,42 @@ fn the_2d_family_shades_like_the_3d_family_with_effects() {
     // wherever they pick the same triangle and blend the same fragments, the
     // colour is bitwise the same: shading reads the triangle and the ray, not
     // the family's depth.
-    for name in EFFECT_SCENES {
-        let scene = prepared(name);
-        for camera in scene.scene.all_cameras() {
-            let three = render_with(&scene, AlgorithmId::ThreeDBrute, &camera, SIZE.0, SIZE.1);
-            for algorithm in AlgorithmId::CPU
-                .into_iter()
-                .filter(|a| a.family() == Family::TwoD)
-            {
-                let two = render_with(&scene, algorithm, &camera, SIZE.0, SIZE.1);
-                let report = continuum_tests::explain_2d_3d(&scene, &two, &three);
-                let at = format!("{name}/{} {algorithm}", camera.name);
-                assert!(
-                    report.unexplained.is_empty(),
-                    "{at}: {:?}",
-                    report.unexplained
-                );
-                let (a, b) = (&two.framebuffer, &three.framebuffer);
-                assert_eq!(a.blended, b.blended, "{at}: fragments blended");
-                let differ: Vec<usize> = (0..a.color.len())
-                    .filter(|&i| a.triangle_id[i] == b.triangle_id[i] && a.color[i] != b.color[i])
-                    .collect();
-                assert!(
-                    differ.is_empty(),
-                    "{at}: same triangle, other colour at {differ:?}"
-                );
-            }
-        }
+    let mut three: Option<continuum::RenderOutput> = None;
+    let rendered = Matrix {
+        scenes: EFFECT_SCENES.map(String::from).to_vec(),
+        cameras: Cameras::AllAndDefault,
+        algorithms: vec![
+            AlgorithmId::ThreeDBrute,
+            AlgorithmId::TwoDBrute,
+            AlgorithmId::TwoDBin,
+        ],
+        size: SIZE,
+        ..Matrix::new()
     }
+    .run(|cell| {
+        if cell.request.algorithm == AlgorithmId::ThreeDBrute {
+            three = Some(cell.output.clone());
+            return;
+        }
+        let three = three.as_ref().expect("3dr-brute renders first");
+        let two = cell.output;
+        let report = continuum_tests::explain_2d_3d(cell.prepared, two, three);
+        let at = cell.label();
+        assert!(
+            report.unexplained.is_empty(),
+            "{at}: {:?}",
+            report.unexplained
+        );
+        let (a, b) = (&two.framebuffer, &three.framebuffer);
+        assert_eq!(a.blended, b.blended, "{at}: fragments blended");
+        let differ: Vec<usize> = (0..a.color.len())
+            .filter(|&i| a.triangle_id[i] == b.triangle_id[i] && a.color[i] != b.color[i])
+            .collect();
+        assert!(
+            differ.is_empty(),
+            "{at}: same triangle, other colour at {differ:?}"
+        );
+    });
+    // Five scenes, three cameras or more each, three algorithms.
+    assert!(rendered >= 5 * 3 * 3, "only {rendered} renders");
 }

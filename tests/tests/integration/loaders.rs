@@ -230,16 +230,21 @@ fn degenerate_triangles_load_but_are_never_drawn() {
     let scene: PreparedScene =
         continuum_tests::scene_from_triangles(positions, triangles, camera.clone());
     assert_eq!(scene.drawable, vec![2]);
-    for algorithm in AlgorithmId::ALL {
-        let out = continuum_tests::render_with(&scene, algorithm, &camera, 64, 64);
+    let every_algorithm = continuum_tests::matrix::Matrix {
+        algorithms: AlgorithmId::ALL.to_vec(),
+        size: (64, 64),
+        ..continuum_tests::matrix::Matrix::new()
+    };
+    let rendered = every_algorithm.run_on("degenerate", &scene, |cell| {
+        let ids = &cell.output.framebuffer.triangle_id;
+        let label = cell.label();
         assert!(
-            out.framebuffer
-                .triangle_id
-                .iter()
-                .all(|&t| t == 2 || t == continuum::BACKGROUND)
+            ids.iter().all(|&t| t == 2 || t == continuum::BACKGROUND),
+            "{label}"
         );
-        assert!(out.framebuffer.triangle_id.contains(&2));
-    }
+        assert!(ids.contains(&2), "{label}");
+    });
+    assert_eq!(rendered, AlgorithmId::ALL.len());
 }
 
 #[test]

@@ -2,8 +2,18 @@
 //! one triangle, the Direct3D way, in every algorithm.
 
 use continuum::{AlgorithmId, BACKGROUND, Family};
-use continuum_tests::{exact_camera, pixel_point, render_with, scene_from_triangles};
+use continuum_tests::matrix::Matrix;
+use continuum_tests::{exact_camera, pixel_point, scene_from_triangles};
 use glam::Vec3;
+
+/// Every algorithm, the GPU's included, through the scene's camera at 8×8.
+fn every_algorithm() -> Matrix {
+    Matrix {
+        algorithms: AlgorithmId::ALL.to_vec(),
+        size: (8, 8),
+        ..Matrix::new()
+    }
+}
 
 /// Direct3D's worked example: a 5×5 square from (0.5, 0.5) to (5.5, 5.5) split
 /// along its diagonal covers 15 + 10 pixels, none twice.
@@ -18,8 +28,8 @@ fn direct3d_square_split_along_its_diagonal_gives_15_and_10() {
     // Triangle 0 is above-right of the diagonal, triangle 1 below-left.
     for winding in [[[0, 1, 2], [0, 2, 3]], [[0, 2, 1], [0, 3, 2]]] {
         let scene = scene_from_triangles(positions.clone(), winding.to_vec(), exact_camera());
-        for algorithm in AlgorithmId::ALL {
-            let out = render_with(&scene, algorithm, &exact_camera(), 8, 8);
+        let rendered = every_algorithm().run_on("square", &scene, |cell| {
+            let (algorithm, out) = (cell.request.algorithm, cell.output);
             let fb = &out.framebuffer;
             let count = |id: u32| fb.triangle_id.iter().filter(|&&t| t == id).count();
             assert_eq!(
@@ -47,7 +57,8 @@ fn direct3d_square_split_along_its_diagonal_gives_15_and_10() {
                     }
                 }
             }
-        }
+        });
+        assert_eq!(rendered, AlgorithmId::ALL.len(), "winding {winding:?}");
     }
 }
 
@@ -75,8 +86,8 @@ fn fan_around_a_vertex_on_a_pixel_centre_covers_each_pixel_once() {
     let triangles: Vec<[u32; 3]> = (0..8).map(|k| [0, 1 + k, 1 + (k + 1) % 8]).collect();
     let scene = scene_from_triangles(positions, triangles, exact_camera());
     let mut three_d = 0;
-    for algorithm in AlgorithmId::ALL {
-        let out = render_with(&scene, algorithm, &exact_camera(), 8, 8);
+    let rendered = every_algorithm().run_on("fan", &scene, |cell| {
+        let (algorithm, out) = (cell.request.algorithm, cell.output);
         let fb = &out.framebuffer;
         for y in 0..8u32 {
             for x in 0..8u32 {
@@ -105,7 +116,8 @@ fn fan_around_a_vertex_on_a_pixel_centre_covers_each_pixel_once() {
                 "{algorithm}"
             );
         }
-    }
+    });
+    assert_eq!(rendered, AlgorithmId::ALL.len());
     assert_eq!(
         three_d, 7,
         "2dr-homogeneous, the five 3D rasterizers and raycast"
