@@ -1,7 +1,7 @@
 //! What the viewer renders: one configuration (scene, camera, algorithm, oracles,
 //! anti-aliasing, precision, size, threads), turned into the core's
-//! [`RenderRequest`]. The words are the CLI's (`continuum render`), parsed by
-//! the same functions in `continuum::request`.
+//! [`RenderRequest`]. The words are the CLI's (`continuum render`), through the
+//! same front door (`continuum::RenderWords`) and capability check (`continuum::check`).
 
 use std::path::{Path, PathBuf};
 
