@@ -235,12 +235,6 @@ impl Pipeline {
         set(&mut samples.incremental, oracles.incremental);
         set(&mut samples.early_z, oracles.early_z);
         samples.leaf = oracles.leaf.unwrap_or(samples.leaf);
-        let traversal = [
-            ("outside", oracles.outside.is_some()),
-            ("occluded", oracles.occluded.is_some()),
-            ("split", oracles.split.is_some()),
-            ("frustum", oracles.frustum.is_some()),
-        ];
         match &mut p {
             Pipeline::Frusta(t) => {
                 set(&mut t.outside, oracles.outside);
@@ -249,6 +243,12 @@ impl Pipeline {
                 t.frustum = oracles.frustum.unwrap_or(t.frustum);
             }
             _ => {
+                let traversal = [
+                    ("outside", oracles.outside.is_some()),
+                    ("occluded", oracles.occluded.is_some()),
+                    ("split", oracles.split.is_some()),
+                    ("frustum", oracles.frustum.is_some()),
+                ];
                 if let Some((key, _)) = traversal.iter().find(|(_, given)| *given) {
                     return Err(bad(&format!(
                         "'{key}' needs a BVH algorithm (3dr-frustum-cull, 3dr-frustum-split, 3dr-full)"
@@ -257,11 +257,6 @@ impl Pipeline {
             }
         }
         Ok(p)
-    }
-
-    /// Does this pipeline take oracle settings at all?
-    pub fn takes_oracles(self) -> bool {
-        matches!(self, Pipeline::AllTriangles { .. } | Pipeline::Frusta(_))
     }
 
     /// Can this pipeline render `viewport`? Straight edges (the 2D family) and

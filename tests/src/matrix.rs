@@ -5,9 +5,11 @@
 //! there were (and a matrix that renders nothing fails), so no test passes
 //! by checking nothing.
 
+use std::collections::HashMap;
+
 use continuum::{
-    AaMode, AlgorithmId, Camera, Family, Oracles, Precision, PreparedScene, RenderOutput,
-    RenderRequest, Viewport, render,
+    AaMode, AlgorithmId, Camera, Oracles, Precision, PreparedScene, RenderOutput, RenderRequest,
+    Viewport, render,
 };
 
 use crate::{builtin_scenes, prepared};
@@ -99,10 +101,6 @@ impl Cell<'_> {
             "{}/{} {} {} {} {} {}",
             self.scene, r.camera.name, r.camera.viewport, r.aa, r.precision, r.algorithm, r.oracles
         )
-    }
-
-    pub fn family(&self) -> Family {
-        self.request.algorithm.family()
     }
 }
 
@@ -222,23 +220,32 @@ impl Matrix {
         rendered
     }
 
+    /// [`Matrix::run`], handing each cell to `check` with the first render
+    /// of its [`Cell::family_key`] (the one the family must agree with;
+    /// `None` for that first render itself).
+    pub fn run_against_first(&self, mut check: impl FnMut(&Cell, Option<&RenderOutput>)) -> usize {
+        let mut first: HashMap<String, RenderOutput> = HashMap::new();
+        self.run(|cell| {
+            let key = cell.family_key();
+            check(cell, first.get(&key));
+            first.entry(key).or_insert_with(|| cell.output.clone());
+        })
+    }
+
     /// Runs the matrix and asserts that within each family every algorithm
     /// renders what the first one did (every buffer hash and the samples'
     /// digest); returns how many renders were compared with a first one.
     pub fn assert_families_agree(&self) -> usize {
-        let mut first: std::collections::HashMap<String, (String, continuum::Hashes)> =
-            std::collections::HashMap::new();
         let mut compared = 0;
-        self.run(|cell| {
-            let hashes = cell.output.hashes.clone();
-            match first.get(&cell.family_key()) {
-                Some((label, h)) => {
-                    compared += 1;
-                    assert_eq!(h, &hashes, "{} differs from {label}", cell.label());
-                }
-                None => {
-                    first.insert(cell.family_key(), (cell.label(), hashes));
-                }
+        self.run_against_first(|cell, first| {
+            if let Some(first) = first {
+                let label = cell.label();
+                assert_eq!(
+                    cell.output.hashes, first.hashes,
+                    "{label} differs from {}",
+                    first.algorithm
+                );
+                compared += 1;
             }
         });
         compared

@@ -1,8 +1,6 @@
 //! Algorithms agree: the 3D family (3dr-brute, raycast) bit for bit; the 2D family
 //! against the 3D family with every differing pixel explained.
 
-use std::collections::HashMap;
-
 use continuum::{AlgorithmId, RenderOutput};
 use continuum_tests::matrix::{Cameras, Matrix};
 use continuum_tests::{
@@ -49,14 +47,13 @@ fn each_family_is_bitwise_identical_on_every_builtin_scene_and_camera() {
             "{name} needs a camera inside the geometry, with triangles through its eye plane"
         );
     }
-    let mut first: HashMap<String, RenderOutput> = HashMap::new();
     let rendered = Matrix {
         cameras: Cameras::All,
         size: (W, H),
         ..Matrix::new()
     }
-    .run(|cell| match first.get(&cell.family_key()) {
-        Some(reference) => {
+    .run_against_first(|cell, first| {
+        if let Some(reference) = first {
             assert_same_buffers(
                 cell.scene,
                 &cell.request.camera.name,
@@ -64,9 +61,6 @@ fn each_family_is_bitwise_identical_on_every_builtin_scene_and_camera() {
                 cell.output,
             );
             checked += 1;
-        }
-        None => {
-            first.insert(cell.family_key(), cell.output.clone());
         }
     });
     // 12 scenes, two cameras or more each, 9 algorithms in 3 families.
