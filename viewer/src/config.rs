@@ -152,14 +152,6 @@ impl Config {
         })
     }
 
-    /// The camera this configuration looks through in `scene`, viewport applied.
-    pub fn camera_in(&self, scene: &Scene) -> Result<Camera, FieldError> {
-        Ok(self
-            .settings(&self.method)?
-            .request_through(self.base_camera(scene)?)?
-            .camera)
-    }
-
     /// The camera before the viewport words: the scene's, or the one the user moved.
     fn base_camera(&self, scene: &Scene) -> Result<Camera, FieldError> {
         match &self.camera {

@@ -231,14 +231,19 @@ fn run_job(
                 })?,
         ),
     };
-    let render_method = |method: &Method| -> Result<RenderOutput, FieldError> {
+    let render_method = |method: &Method| -> Result<(RenderOutput, Camera), FieldError> {
         let request = config.request(&scene, method)?;
-        pool.install(|| render(&scene, &request))
+        let out = pool.install(|| render(&scene, &request))?;
+        Ok((out, request.camera))
     };
-    let a = render_method(&config.method)?;
-    let b = job.compare.as_ref().map(render_method);
+    // The camera A looked through (B's is the same: only the method differs).
+    let (a, camera) = render_method(&config.method)?;
+    let b = job
+        .compare
+        .as_ref()
+        .map(|method| render_method(method).map(|(out, _)| out));
     Ok(Rendered {
-        camera: config.camera_in(&scene.scene)?,
+        camera,
         scene,
         a,
         b,
