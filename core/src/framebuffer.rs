@@ -67,29 +67,43 @@ impl Framebuffer {
         }
     }
 
-    /// The image cut into `size × size` tiles (smaller at the right and
+    /// The image cut into `width × height` tiles (smaller at the right and
     /// bottom), row by row.
-    pub fn tile_rects(&self, size: u32) -> Vec<PixelRect> {
+    pub(crate) fn tile_rects(&self, width: u32, height: u32) -> Vec<PixelRect> {
         let mut rects = Vec::new();
-        for y0 in (0..self.height).step_by(size as usize) {
-            for x0 in (0..self.width).step_by(size as usize) {
+        for y0 in (0..self.height).step_by(height as usize) {
+            for x0 in (0..self.width).step_by(width as usize) {
                 rects.push(PixelRect::new(
                     x0,
                     y0,
-                    (x0 + size).min(self.width),
-                    (y0 + size).min(self.height),
+                    (x0 + width).min(self.width),
+                    (y0 + height).min(self.height),
                 ));
             }
         }
         rects
     }
 
-    /// Buffers for a render whose tiles will store every pixel
-    /// ([`Framebuffer::store_tiles`]): zeroed memory straight from the
-    /// allocator, so no pass over the image runs before the tiles fill it.
-    pub(crate) fn for_tiles(width: u32, height: u32) -> Framebuffer {
+    /// Buffers for a render whose tiles resolve into every pixel
+    /// ([`Framebuffer::tile_planes`]): those of an earlier render of the same
+    /// size when one was [recycled](Framebuffer::recycle), as they are (every
+    /// pixel is written, so nothing is cleared), else zeroed memory straight
+    /// from the allocator. `sample_digest` and `blended` are there when asked for.
+    pub(crate) fn for_tiles(width: u32, height: u32, digest: bool, blended: bool) -> Framebuffer {
         let n = width as usize * height as usize;
-        Framebuffer {
+        let spare = {
+            let mut pool = FRAME_POOL.lock().unwrap_or_else(|e| e.into_inner());
+            let fits = |f: &Framebuffer| {
+                (f.width, f.height) == (width, height)
+                    && [f.depth.len(), f.triangle_id.len(), f.edge_evals.len()]
+                        .iter()
+                        .chain(&[f.coverage_writes.len(), f.color.len()])
+                        .all(|&len| len == n)
+            };
+            let at = pool.iter().position(fits);
+            at.map(|i| pool.swap_remove(i))
+        };
+        let mut fb = spare.unwrap_or_else(|| Framebuffer {
             width,
             height,
             color: vec![[0; 4]; n],
@@ -99,111 +113,167 @@ impl Framebuffer {
             coverage_writes: vec![0; n],
             sample_digest: Vec::new(),
             blended: Vec::new(),
+        });
+        fn optional<T: Copy + Default>(plane: &mut Vec<T>, wanted: bool, n: usize) {
+            if !wanted {
+                plane.clear();
+            } else if plane.len() != n {
+                *plane = vec![T::default(); n];
+            }
         }
+        optional(&mut fb.sample_digest, digest, n);
+        optional(&mut fb.blended, blended, n);
+        fb
     }
 
-    /// Copies resolved tiles into place, rows in parallel. The tiles must not
-    /// overlap; together they cover the image (checked by area).
-    pub(crate) fn store_tiles(&mut self, tiles: &[ResolvedTile]) {
+    /// Gives this framebuffer's memory to the next render of the same size
+    /// (the service, the viewer and `compare` render many frames of one size:
+    /// a reused frame costs no page faults and no clearing). The pool keeps
+    /// the [`FRAME_POOL_SIZE`] most recently recycled frames.
+    pub fn recycle(self) {
+        let mut pool = FRAME_POOL.lock().unwrap_or_else(|e| e.into_inner());
+        if pool.len() == FRAME_POOL_SIZE {
+            pool.remove(0);
+        }
+        pool.push(self);
+    }
+
+    /// Disjoint views of the frame's planes, one per rect of `rects`: the
+    /// rows each tile resolves into. The rects must not overlap and together
+    /// cover the image (checked).
+    pub(crate) fn tile_planes(&mut self, rects: &[PixelRect]) -> Vec<TilePlanes<'_>> {
         let (width, height) = (self.width as usize, self.height as usize);
-        let area = |t: &ResolvedTile| t.rect.width() as usize * t.rect.height() as usize;
+        let area = |r: &PixelRect| r.width() as usize * r.height() as usize;
         assert_eq!(
-            tiles.iter().map(area).sum::<usize>(),
+            rects.iter().map(area).sum::<usize>(),
             width * height,
             "the tiles must cover the image"
         );
-        // Per row, the tiles holding it.
-        let mut rows: Vec<Vec<&ResolvedTile>> = vec![Vec::new(); height];
-        for t in tiles {
-            for row in &mut rows[t.rect.y0 as usize..t.rect.y1 as usize] {
+        // Per row, the tiles holding it, left to right.
+        let mut rows: Vec<Vec<usize>> = vec![Vec::new(); height];
+        for (t, r) in rects.iter().enumerate() {
+            for row in &mut rows[r.y0 as usize..r.y1 as usize] {
                 row.push(t);
             }
         }
-        let n = width * height;
-        if tiles.iter().any(|t| !t.sample_digest.is_empty()) && self.sample_digest.is_empty() {
-            self.sample_digest = vec![0; n];
+        for row in &mut rows {
+            row.sort_unstable_by_key(|&t| rects[t].x0);
         }
-        if tiles.iter().any(|t| !t.blended.is_empty()) && self.blended.is_empty() {
-            self.blended = vec![0; n];
-        }
-        store_rows(&mut self.color, width, &rows, |t| &t.color);
-        store_rows(&mut self.depth, width, &rows, |t| &t.depth);
-        store_rows(&mut self.triangle_id, width, &rows, |t| &t.triangle_id);
-        store_rows(&mut self.edge_evals, width, &rows, |t| &t.edge_evals);
-        store_rows(&mut self.coverage_writes, width, &rows, |t| {
-            &t.coverage_writes
+        let mut planes: Vec<TilePlanes> = rects
+            .iter()
+            .map(|&rect| TilePlanes {
+                rect,
+                color: Vec::new(),
+                depth: Vec::new(),
+                triangle_id: Vec::new(),
+                edge_evals: Vec::new(),
+                coverage_writes: Vec::new(),
+                sample_digest: Vec::new(),
+                blended: Vec::new(),
+            })
+            .collect();
+        split_rows(&mut self.color, width, &rows, rects, &mut planes, |p| {
+            &mut p.color
         });
-        store_rows(&mut self.sample_digest, width, &rows, |t| &t.sample_digest);
-        store_rows(&mut self.blended, width, &rows, |t| &t.blended);
+        split_rows(&mut self.depth, width, &rows, rects, &mut planes, |p| {
+            &mut p.depth
+        });
+        split_rows(
+            &mut self.triangle_id,
+            width,
+            &rows,
+            rects,
+            &mut planes,
+            |p| &mut p.triangle_id,
+        );
+        split_rows(
+            &mut self.edge_evals,
+            width,
+            &rows,
+            rects,
+            &mut planes,
+            |p| &mut p.edge_evals,
+        );
+        split_rows(
+            &mut self.coverage_writes,
+            width,
+            &rows,
+            rects,
+            &mut planes,
+            |p| &mut p.coverage_writes,
+        );
+        split_rows(
+            &mut self.sample_digest,
+            width,
+            &rows,
+            rects,
+            &mut planes,
+            |p| &mut p.sample_digest,
+        );
+        split_rows(&mut self.blended, width, &rows, rects, &mut planes, |p| {
+            &mut p.blended
+        });
+        planes
     }
 }
 
-/// One per-pixel buffer of [`Framebuffer::store_tiles`]: each row (in
-/// parallel) takes its span of every tile in `rows[y]` whose `field` is not
-/// empty. An empty `dst` (an optional buffer the render has not) stays so.
-fn store_rows<T: Copy + Send + Sync>(
-    dst: &mut [T],
+/// Frames kept by [`Framebuffer::recycle`].
+pub const FRAME_POOL_SIZE: usize = 4;
+
+static FRAME_POOL: std::sync::Mutex<Vec<Framebuffer>> = std::sync::Mutex::new(Vec::new());
+
+/// One plane of [`Framebuffer::tile_planes`]: row `y` of `plane` cut at the
+/// borders of the tiles in `rows[y]` (left to right, not overlapping), each
+/// piece pushed onto its tile's `field`. An empty plane (an optional buffer
+/// the render has not) gives every tile no rows.
+fn split_rows<'f, T>(
+    plane: &'f mut [T],
     width: usize,
-    rows: &[Vec<&ResolvedTile>],
-    field: impl Fn(&ResolvedTile) -> &[T] + Sync,
+    rows: &[Vec<usize>],
+    rects: &[PixelRect],
+    planes: &mut [TilePlanes<'f>],
+    field: impl for<'t> Fn(&'t mut TilePlanes<'f>) -> &'t mut Vec<&'f mut [T]>,
 ) {
-    use rayon::prelude::*;
-    if dst.is_empty() {
+    if plane.is_empty() {
         return;
     }
-    dst.par_chunks_mut(width)
-        .zip(rows)
-        .enumerate()
-        .for_each(|(y, (row, tiles))| {
-            for &t in tiles {
-                let src = field(t);
-                if src.is_empty() {
-                    continue;
-                }
-                let (x0, y0, x1) = (t.rect.x0 as usize, t.rect.y0 as usize, t.rect.x1 as usize);
-                let w = x1 - x0;
-                let start = (y - y0) * w;
-                row[x0..x1].copy_from_slice(&src[start..start + w]);
-            }
-        });
+    for (row, tiles) in plane.chunks_mut(width).zip(rows) {
+        let (mut rest, mut at) = (row, 0);
+        for &t in tiles {
+            let (x0, x1) = (rects[t].x0 as usize, rects[t].x1 as usize);
+            assert!(x0 >= at, "tiles overlap in a row");
+            let (_, from_x0) = std::mem::take(&mut rest).split_at_mut(x0 - at);
+            let (piece, after) = from_x0.split_at_mut(x1 - x0);
+            field(&mut planes[t]).push(piece);
+            (rest, at) = (after, x1);
+        }
+    }
 }
 
-/// A tile's pixels after the resolve: what [`Framebuffer::store_tiles`] copies, plus
-/// what the resolve counted.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct ResolvedTile {
+/// A tile's pixels in the frame's planes: row `r` of each is the tile's row
+/// `rect.y0 + r`, columns `rect.x0..rect.x1`. The resolve writes them in place;
+/// an optional plane the render has not has no rows.
+#[derive(Debug)]
+pub(crate) struct TilePlanes<'f> {
     pub rect: PixelRect,
-    pub color: Vec<[u8; 4]>,
-    pub depth: Vec<f32>,
-    pub triangle_id: Vec<u32>,
-    pub edge_evals: Vec<u32>,
-    pub coverage_writes: Vec<u32>,
-    pub sample_digest: Vec<u64>,
-    /// Transparent fragments blended per pixel (empty without transparency).
-    pub blended: Vec<u32>,
+    pub color: Vec<&'f mut [[u8; 4]]>,
+    pub depth: Vec<&'f mut [f32]>,
+    pub triangle_id: Vec<&'f mut [u32]>,
+    pub edge_evals: Vec<&'f mut [u32]>,
+    pub coverage_writes: Vec<&'f mut [u32]>,
+    pub sample_digest: Vec<&'f mut [u64]>,
+    pub blended: Vec<&'f mut [u32]>,
+}
+
+/// What the resolve of one tile counted.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct TileTotals {
     /// Coverage writes per stored sample: zero, one, many.
     pub histogram: CoverageHistogram,
     /// Shading evaluations made.
     pub shading_samples: u64,
     /// What the tile's effect rays cost.
     pub effects: crate::effects::EffectCounters,
-}
-
-impl ResolvedTile {
-    /// A tile of `rect` left empty (zeroed buffers, nothing counted): what a
-    /// cancelled render stores for the tiles it no longer renders.
-    pub(crate) fn blank(rect: PixelRect) -> ResolvedTile {
-        let n = rect.width() as usize * rect.height() as usize;
-        ResolvedTile {
-            rect,
-            color: vec![[0; 4]; n],
-            depth: vec![0.0; n],
-            triangle_id: vec![0; n],
-            edge_evals: vec![0; n],
-            coverage_writes: vec![0; n],
-            ..ResolvedTile::default()
-        }
-    }
 }
 
 /// A covered sample of a see-through triangle: kept beside the w-buffer, not

@@ -86,8 +86,6 @@ pub fn render_cancellable(
         request.height,
         scene.default_near,
     )?;
-    // Every path stores every pixel through `Framebuffer::store_tiles`.
-    let mut fb = Framebuffer::for_tiles(request.width, request.height);
     let mut stats = Stats::default();
     let pattern = request.aa.pattern();
     let context = algorithm::TileContext {
@@ -97,6 +95,15 @@ pub fn render_cancellable(
         opacity: &scene.triangle_opacity,
         cancel,
     };
+    // Every path resolves every pixel through `Framebuffer::tile_planes`.
+    let start = Instant::now();
+    let mut fb = Framebuffer::for_tiles(
+        request.width,
+        request.height,
+        pattern.coverage() > 1,
+        context.shader.plan().transparency,
+    );
+    stats.time_ms.store = start.elapsed().as_secs_f64() * 1e3;
     algorithm::run(
         pipeline,
         request.precision,
@@ -112,6 +119,7 @@ pub fn render_cancellable(
         ));
     }
 
+    let start = Instant::now();
     (stats.edge_evaluations, stats.max_edge_evals_per_pixel) = fb
         .edge_evals
         .par_chunks(4096)
@@ -129,6 +137,7 @@ pub fn render_cancellable(
     stats.predicted_instructions =
         stats.triangle_setups * setup_cost + stats.edge_evaluations * sample_cost;
     let hashes = Hashes::of(&fb);
+    stats.time_ms.store += start.elapsed().as_secs_f64() * 1e3;
     stats.time_ms.total = total.elapsed().as_secs_f64() * 1e3;
     Ok(RenderOutput {
         algorithm: request.algorithm,

@@ -30,8 +30,12 @@ use glam::Vec3;
 use crate::camera::View;
 use crate::color::{BACKGROUND_COLOR, OUTSIDE_VIEWPORT_COLOR, encode_rgb, linear_rgb};
 use crate::effects::EffectCounters;
-use crate::framebuffer::{BACKGROUND, Fragment, ResolvedTile, TileBuffer, wins_depth_test};
+use crate::framebuffer::{
+    BACKGROUND, Fragment, TileBuffer, TilePlanes, TileTotals, wins_depth_test,
+};
 use crate::shade::Shader;
+use crate::shade::eight::EightSamples;
+use crate::simd::{self, Lanes};
 use crate::stats::CoverageHistogram;
 
 /// Most stored samples a pattern has (`ssaa:256`).
@@ -104,65 +108,79 @@ impl FragmentLayers {
     }
 }
 
-/// Resolves every pixel of `tile`.
-pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> ResolvedTile {
+/// The resolve of `tile` into its place in the frame, `out`: each pixel's
+/// first stored sample (depth, triangle id), its counters summed over its
+/// samples and, with anti-aliasing, its sample digest; returns the tile's
+/// coverage histogram. Colours are [`shade_tile`]'s.
+pub(crate) fn resolve_tile(tile: &TileBuffer, out: &mut TilePlanes) -> CoverageHistogram {
     let pattern = tile.pattern;
     let (stored, pixels) = (pattern.stored, tile.pixels);
-    debug_assert!(stored <= MAX_STORED);
-    let background = linear_rgb(BACKGROUND_COLOR);
-    let outside = linear_rgb(OUTSIDE_VIEWPORT_COLOR);
-    let mut out = ResolvedTile {
-        rect: tile.rect(),
-        color: vec![[0; 4]; pixels],
-        depth: tile.depth[..pixels].to_vec(),
-        triangle_id: tile.triangle_id[..pixels].to_vec(),
-        edge_evals: tile.edge_evals.clone(),
-        coverage_writes: vec![0; pixels],
-        sample_digest: Vec::new(),
-        blended: if shader.plan().transparency {
-            vec![0; pixels]
-        } else {
-            Vec::new()
-        },
-        histogram: CoverageHistogram::of(&tile.coverage_writes),
-        shading_samples: 0,
-        effects: EffectCounters::for_plan(shader.plan()),
-    };
-    for (s, writes) in tile.coverage_writes.chunks_exact(pixels).enumerate() {
-        if s == 0 {
-            out.coverage_writes.copy_from_slice(writes);
-        } else {
-            for (sum, &w) in out.coverage_writes.iter_mut().zip(writes) {
+    let width = (tile.x1 - tile.x0) as usize;
+    let masks = pattern.has_coverage_only();
+    for (r, start) in (0..pixels).step_by(width).enumerate() {
+        let row = start..start + width;
+        out.depth[r].copy_from_slice(&tile.depth[row.clone()]);
+        out.triangle_id[r].copy_from_slice(&tile.triangle_id[row.clone()]);
+        out.edge_evals[r].copy_from_slice(&tile.edge_evals[row.clone()]);
+        let writes = &mut *out.coverage_writes[r];
+        writes.copy_from_slice(&tile.coverage_writes[row.clone()]);
+        for s in 1..stored {
+            let layer = &tile.coverage_writes[s * pixels + start..][..width];
+            for (sum, &w) in writes.iter_mut().zip(layer) {
                 *sum += w;
             }
         }
+        // The digest of every sample's id (and mask), sample by sample.
+        if let Some(digest) = out.sample_digest.get_mut(r) {
+            digest.fill(DIGEST_SEED);
+            for s in 0..stored {
+                let ids = &tile.triangle_id[s * pixels + start..][..width];
+                for (d, &id) in digest.iter_mut().zip(ids) {
+                    *d = mix(*d, id);
+                }
+                if masks {
+                    let masks = &tile.masks[s * pixels + start..][..width];
+                    for (d, &m) in digest.iter_mut().zip(masks) {
+                        *d = mix(*d, m);
+                    }
+                }
+            }
+        }
     }
+    CoverageHistogram::of(&tile.coverage_writes)
+}
+
+/// The colour of every pixel of `tile`, written into `out` (and, with
+/// transparency, the fragments blended there): the shading of its samples
+/// and the box filter over them. Returns what the shading counted.
+pub(crate) fn shade_tile(
+    tile: &TileBuffer,
+    view: &View,
+    shader: &Shader,
+    out: &mut TilePlanes,
+) -> TileTotals {
+    let pattern = tile.pattern;
+    let (stored, pixels) = (pattern.stored, tile.pixels);
+    debug_assert!(stored <= MAX_STORED);
+    let mut totals = TileTotals {
+        effects: EffectCounters::for_plan(shader.plan()),
+        ..TileTotals::default()
+    };
     if stored == 1 && pattern.coverage() == 1 && tile.fragments.is_empty() && !force_general() {
-        resolve_single(tile, view, shader, &mut out);
-        return out;
+        shade_single(tile, view, shader, out, &mut totals);
+        return totals;
     }
+    let background = linear_rgb(BACKGROUND_COLOR);
+    let outside = linear_rgb(OUTSIDE_VIEWPORT_COLOR);
     let anti_aliased = pattern.coverage() > 1;
-    // Layer by layer (contiguous, independent per pixel): the digest of every
-    // sample's id (and mask), and whether a pixel's stored samples all hold
-    // one triangle.
+    // Layer by layer (contiguous, independent per pixel): whether a pixel's
+    // stored samples all hold one triangle.
     let mut uniform = vec![!pattern.shade_per_sample; pixels];
-    if anti_aliased {
+    if anti_aliased && !pattern.shade_per_sample {
         let ids = &tile.triangle_id;
-        out.sample_digest = vec![DIGEST_SEED; pixels];
-        for (s, layer) in ids.chunks_exact(pixels).enumerate() {
-            for (d, &id) in out.sample_digest.iter_mut().zip(layer) {
-                *d = mix(*d, id);
-            }
-            if pattern.has_coverage_only() {
-                let masks = &tile.masks[s * pixels..(s + 1) * pixels];
-                for (d, &m) in out.sample_digest.iter_mut().zip(masks) {
-                    *d = mix(*d, m);
-                }
-            }
-            if s > 0 && !pattern.shade_per_sample {
-                for ((u, &id), &first) in uniform.iter_mut().zip(layer).zip(&ids[..pixels]) {
-                    *u &= id == first;
-                }
+        for layer in ids.chunks_exact(pixels).skip(1) {
+            for ((u, &id), &first) in uniform.iter_mut().zip(layer).zip(&ids[..pixels]) {
+                *u &= id == first;
             }
         }
     }
@@ -172,8 +190,8 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
     // Per pixel without per-sample shading: the colour of each transparent
     // triangle, shaded once (as its opaque counterpart would be).
     let mut fragment_colors: Vec<(u32, (Vec3, f32))> = Vec::new();
-    for y in tile.y0..tile.y1 {
-        for x in tile.x0..tile.x1 {
+    for (r, y) in (tile.y0..tile.y1).enumerate() {
+        for (c, x) in (tile.x0..tile.x1).enumerate() {
             let i = tile.index(x, y);
             let id_at = |s: usize| tile.triangle_id[s * pixels + i];
             let depth_at = |s: usize| tile.depth[s * pixels + i];
@@ -202,8 +220,8 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
                     (None, None) => outside,
                     (None, Some(_)) if id == BACKGROUND => background,
                     (None, Some(ray)) => {
-                        out.shading_samples += 1;
-                        shader.shade(id, at, ray, depth_at(s), &mut out.effects)
+                        totals.shading_samples += 1;
+                        shader.shade(id, at, ray, depth_at(s), &mut totals.effects)
                     }
                 };
                 slot_color[s] = surface_color[s];
@@ -221,8 +239,9 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
                         let (color, alpha) = match cached {
                             Some(&(_, c)) if !pattern.shade_per_sample => c,
                             _ => {
-                                out.shading_samples += 1;
-                                let c = shader.shade_fragment(f.id, at, ray, f.w, &mut out.effects);
+                                totals.shading_samples += 1;
+                                let c =
+                                    shader.shade_fragment(f.id, at, ray, f.w, &mut totals.effects);
                                 fragment_colors.push((f.id, c));
                                 c
                             }
@@ -230,66 +249,111 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, view: &View, shader: &Shader) -> R
                         slot_color[s] = color * alpha + slot_color[s] * (1.0 - alpha);
                     }
                     blended += front as u32;
-                    out.effects.fragments_blended += front as u64;
-                    out.effects.transparency_s += start.elapsed().as_secs_f64();
+                    totals.effects.fragments_blended += front as u64;
+                    totals.effects.transparency_s += start.elapsed().as_secs_f64();
                 }
             }
-            if !out.blended.is_empty() {
-                out.blended[i] = blended;
+            if let Some(row) = out.blended.get_mut(r) {
+                row[c] = blended;
             }
             // 3. The box filter over the coverage samples.
-            if !anti_aliased {
+            out.color[r][c] = if !anti_aliased {
                 // Exactly the stored colours, not a round trip through linear light.
-                out.color[i] = if id_at(0) != BACKGROUND || blended > 0 {
+                if id_at(0) != BACKGROUND || blended > 0 {
                     encode_rgb(slot_color[0])
                 } else if slot_color[0] == outside {
                     OUTSIDE_VIEWPORT_COLOR
                 } else {
                     BACKGROUND_COLOR
-                };
-                continue;
-            }
-            out.color[i] = encode_rgb(if uniform && view.sphere.is_none() {
+                }
+            } else if uniform && view.sphere.is_none() {
                 // Every coverage sample sees this one surface.
-                slot_color[0]
+                encode_rgb(slot_color[0])
             } else {
                 if uniform {
                     let first = slot_color[0];
                     slot_color[1..stored].fill(first);
                 }
-                mixed_color(tile, view, i, (x, y), &slot_color, [background, outside])
-                    / pattern.coverage() as f32
-            });
+                let sum = mixed_color(tile, view, i, (x, y), &slot_color, [background, outside]);
+                encode_rgb(sum / pattern.coverage() as f32)
+            };
         }
     }
-    out
+    totals
 }
 
-/// [`resolve_tile`] of a tile with one sample per pixel and no see-through
-/// fragments (no anti-aliasing, opaque surfaces): each pixel's colour is its
-/// sample's, exactly as the general path computes it, without its per-sample
-/// bookkeeping.
-fn resolve_single(tile: &TileBuffer, view: &View, shader: &Shader, out: &mut ResolvedTile) {
+simd::dispatch! {
+    /// [`shade_tile`] of a tile with one sample per pixel and no see-through
+    /// fragments (no anti-aliasing, opaque surfaces): each pixel's colour is
+    /// its sample's, exactly as the general path computes it, without its
+    /// per-sample bookkeeping — eight pixels of a row at a time where the
+    /// view is planar and the material allows ([`Shader::shade_eight`]).
+    fn shade_single<>(
+        tile: &TileBuffer,
+        view: &View,
+        shader: &Shader,
+        out: &mut TilePlanes,
+        totals: &mut TileTotals,
+    ) -> () => shade_single_on
+}
+
+/// [`shade_single`] on lanes `L`.
+#[inline(always)]
+fn shade_single_on<L: Lanes>(
+    tile: &TileBuffer,
+    view: &View,
+    shader: &Shader,
+    out: &mut TilePlanes,
+    totals: &mut TileTotals,
+) {
     let [ox, oy] = tile.pattern.positions[0];
-    for y in tile.y0..tile.y1 {
-        for x in tile.x0..tile.x1 {
-            let i = tile.index(x, y);
-            let (id, at) = (tile.triangle_id[i], (x as f32 + ox, y as f32 + oy));
-            out.color[i] = if id == BACKGROUND {
-                // Only non-planar viewports have pixels without a ray.
-                match view.sphere.is_some() && view.ray(at.0, at.1).is_none() {
-                    true => OUTSIDE_VIEWPORT_COLOR,
-                    false => BACKGROUND_COLOR,
-                }
-            } else {
-                match view.ray(at.0, at.1) {
-                    Some(ray) => {
-                        out.shading_samples += 1;
-                        encode_rgb(shader.shade(id, at, ray, tile.depth[i], &mut out.effects))
-                    }
-                    None => encode_rgb(linear_rgb(OUTSIDE_VIEWPORT_COLOR)),
-                }
+    let width = (tile.x1 - tile.x0) as usize;
+    for (r, y) in (tile.y0..tile.y1).enumerate() {
+        let ids = &tile.triangle_id[r * width..][..width];
+        let depths = &tile.depth[r * width..][..width];
+        let colors = &mut *out.color[r];
+        for c0 in (0..width).step_by(8) {
+            let n = (width - c0).min(8);
+            let mut eight = EightSamples {
+                ids: [BACKGROUND; 8],
+                x: [0.0; 8],
+                y: y as f32 + oy,
+                lanes: 0,
             };
+            for l in 0..n {
+                let id = ids[c0 + l];
+                eight.ids[l] = id;
+                eight.x[l] = (tile.x0 + (c0 + l) as u32) as f32 + ox;
+                if id != BACKGROUND && shader.shades_in_lanes(id) {
+                    eight.lanes |= 1 << l;
+                }
+            }
+            let (linear, done) = match eight.lanes {
+                0 => ([Vec3::ZERO; 8], 0),
+                _ => shader.shade_eight::<L>(&eight),
+            };
+            totals.shading_samples += u64::from(done.count_ones());
+            for l in 0..n {
+                let (id, at) = (eight.ids[l], (eight.x[l], eight.y));
+                colors[c0 + l] = if done & (1 << l) != 0 {
+                    encode_rgb(linear[l])
+                } else if id == BACKGROUND {
+                    // Only non-planar viewports have pixels without a ray.
+                    match view.sphere.is_some() && view.ray(at.0, at.1).is_none() {
+                        true => OUTSIDE_VIEWPORT_COLOR,
+                        false => BACKGROUND_COLOR,
+                    }
+                } else {
+                    match view.ray(at.0, at.1) {
+                        Some(ray) => {
+                            totals.shading_samples += 1;
+                            let effects = &mut totals.effects;
+                            encode_rgb(shader.shade(id, at, ray, depths[c0 + l], effects))
+                        }
+                        None => encode_rgb(linear_rgb(OUTSIDE_VIEWPORT_COLOR)),
+                    }
+                };
+            }
         }
     }
 }
@@ -375,12 +439,16 @@ mod tests {
     use super::FORCE_GENERAL;
     use crate::{AlgorithmId, PreparedScene, RenderRequest, Viewport, render};
 
-    /// The single-sample path gives every pixel the colour the general path
-    /// gives it: lit, shadowed, mirrored and textured scenes; planar views and
-    /// the parabolic one (pixels without a ray); a rasterizer and the ray caster.
+    /// The single-sample path — eight pixels at a time where it can — gives
+    /// every pixel the colour the general, scalar path gives it: a headlight,
+    /// directional and point lights, interpolated normals, shadowed, mirrored
+    /// and textured scenes; perspective, orthographic and parabolic views
+    /// (pixels without a ray); a rasterizer and the ray caster.
     #[test]
     fn the_single_sample_resolve_matches_the_general_one() {
-        for name in ["soup", "checker", "shadows", "mirror"] {
+        let names = ["soup", "sphere", "teapots", "checker", "shadows", "mirror"];
+        let mut rendered = 0;
+        for name in names {
             let path = format!("{}/../scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"));
             let scene = crate::scene::load_path(path.as_ref()).expect("built-in scene loads");
             let scene = PreparedScene::new(scene);
@@ -389,9 +457,16 @@ mod tests {
                 viewport: Viewport::Parabolic,
                 ..camera.clone()
             };
+            let orthographic = crate::Camera {
+                viewport: Viewport::Orthographic {
+                    height: 2.0 * scene.bounds.radius(),
+                },
+                ..camera.clone()
+            };
             for (algorithm, camera) in [
                 (AlgorithmId::ThreeDBrute, &camera),
                 (AlgorithmId::Raycast, &camera),
+                (AlgorithmId::TwoDBrute, &orthographic),
                 (AlgorithmId::Raycast, &parabolic),
             ] {
                 let request = RenderRequest::new(algorithm, camera.clone(), 96, 64);
@@ -405,7 +480,9 @@ mod tests {
                 let (fast, general) = (colors(false), colors(true));
                 assert!(fast.1 > 0, "{name} {algorithm}: something is shaded");
                 assert_eq!(fast, general, "{name} {algorithm} {}", camera.viewport);
+                rendered += 1;
             }
         }
+        assert_eq!(rendered, names.len() * 4);
     }
 }

@@ -50,6 +50,8 @@ mod sealed {
         fn to_array(self) -> [f32; 8];
         fn max(self, o: Self) -> Self;
         fn min(self, o: Self) -> Self;
+        /// The correctly rounded square root (IEEE, as `f32::sqrt`).
+        fn sqrt(self) -> Self;
         fn gt(self, o: Self) -> u8;
         fn lt(self, o: Self) -> u8;
         fn ge(self, o: Self) -> u8;
@@ -78,6 +80,10 @@ impl sealed::Ops for Portable {
     #[inline(always)]
     fn min(self, o: Self) -> Self {
         self.fast_min(o)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        wide::f32x8::sqrt(self)
     }
     #[inline(always)]
     fn gt(self, o: Self) -> u8 {
@@ -180,6 +186,10 @@ mod avx2_lanes {
         #[inline(always)]
         fn min(self, o: Self) -> Self {
             Avx2(avx!(_mm256_min_ps(self.0, o.0)))
+        }
+        #[inline(always)]
+        fn sqrt(self) -> Self {
+            Avx2(avx!(_mm256_sqrt_ps(self.0)))
         }
         #[inline(always)]
         fn gt(self, o: Self) -> u8 {

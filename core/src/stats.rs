@@ -1,10 +1,10 @@
 //! What a render did and what it cost: per-stage wall times, counters, the
 //! coverage histogram and hashes of the result buffers.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Wall time of each stage of one render, in milliseconds.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct StageTimes {
     /// Triangle setup (transform, clip, bounds, edge coefficients) and binning into bands.
     pub setup: f64,
@@ -12,8 +12,16 @@ pub struct StageTimes {
     pub traversal: f64,
     /// Per-sample coverage and depth tests over bounding boxes.
     pub coverage: f64,
-    /// Shading of visible samples and the resolve into pixels.
+    /// The resolve: each pixel's samples into the frame (depth, triangle id,
+    /// per-pixel counters, sample digests, the coverage histogram).
+    pub resolve: f64,
+    /// Shading of visible samples, the box filter and the sRGB encode.
     pub shading: f64,
+    /// The frame around the algorithm: its planes taken and cut into tiles,
+    /// and the finished frame's totals and hashes.
+    pub store: f64,
+    /// The whole render; the stages above add up to it, less the few
+    /// microseconds that set up the view and the shader.
     pub total: f64,
 }
 

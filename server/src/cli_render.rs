@@ -119,7 +119,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     } else {
         let s = &out.stats;
         write_stdout(&format!(
-            "{} {} {}x{}: {:.2} ms (setup {:.2}, traversal {:.2}, coverage {:.2}, shading {:.2}); {} setups, {} edge evaluations, {} BVH nodes; coverage 0/1/many = {}/{}/{}; ids {}\n",
+            "{} {} {}x{}: {:.2} ms (setup {:.2}, traversal {:.2}, coverage {:.2}, resolve {:.2}, shading {:.2}, store {:.2}); {} setups, {} edge evaluations, {} BVH nodes; coverage 0/1/many = {}/{}/{}; ids {}\n",
             summary.scene,
             summary.algorithm,
             width,
@@ -128,7 +128,9 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             s.time_ms.setup,
             s.time_ms.traversal,
             s.time_ms.coverage,
+            s.time_ms.resolve,
             s.time_ms.shading,
+            s.time_ms.store,
             s.triangle_setups,
             s.edge_evaluations,
             s.bvh_nodes_visited,

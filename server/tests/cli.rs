@@ -391,6 +391,21 @@ fn compare_writes_results_with_the_documented_keys() {
             assert_eq!(visibility, median, "{row}");
         } else {
             assert!(visibility > 0.0 && visibility <= median, "{row}");
+            // The stages are disjoint spans of the render: together no more
+            // than its total; each row carries their medians.
+            let t = &row["stats"]["time_ms"];
+            let stages = [
+                "setup",
+                "traversal",
+                "coverage",
+                "resolve",
+                "shading",
+                "store",
+            ];
+            let sum: f64 = stages.iter().map(|s| t[s].as_f64().expect(s)).sum();
+            let total = t["total"].as_f64().expect("total");
+            assert!(sum > 0.0 && sum <= total * (1.0 + 1e-9), "{row}");
+            assert!(row["stage_ms"]["shading"].as_f64().expect("stage_ms") > 0.0);
         }
     }
     let csv = std::fs::read_to_string(dir.join("results.csv")).expect("results.csv");
@@ -464,6 +479,54 @@ fn compare_measures_anti_aliasing_against_the_reference() {
         stderr.contains("--aa") && stderr.contains("valid modes"),
         "{stderr}"
     );
+}
+
+/// `--threads 1,2`: every cell at each count, each row with its speed-up
+/// over one thread, the report with the stage stacks and the thread table.
+#[test]
+fn compare_measures_each_thread_count() {
+    let dir = out_dir("compare-threads");
+    let out = continuum(&[
+        "compare",
+        "--scenes",
+        "box",
+        "--algorithms",
+        "2dr-brute,3dr-full",
+        "--size",
+        "48x32",
+        "--repeat",
+        "1",
+        "--threads",
+        "2,1",
+        "--out",
+        dir.to_str().expect("utf-8"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc = results_json(&dir);
+    let rows = doc["rows"].as_array().expect("rows");
+    let threads: Vec<u64> = rows
+        .iter()
+        .map(|r| r["threads"].as_u64().expect("threads"))
+        .collect();
+    assert_eq!(threads, [1, 1, 2, 2], "each count in turn, smallest first");
+    for row in rows {
+        let speedup = row["speedup"].as_f64().expect("speedup");
+        assert!(speedup > 0.0, "{row}");
+        if row["threads"] == 1 {
+            assert_eq!(speedup, 1.0, "{row}");
+        }
+        assert!(row["ratio_to_2dr_brute"].as_f64().is_some(), "{row}");
+    }
+    assert_eq!(doc["machine"]["threads"], serde_json::json!([1, 2]));
+    let html = std::fs::read_to_string(dir.join("report.html")).expect("report.html");
+    assert!(html.contains("id=\"stages\"") && html.contains("id=\"threads\""));
+    let bad = continuum(&["compare", "--threads", "0,2", "--out", "/tmp/never"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--threads"));
 }
 
 #[test]
@@ -594,6 +657,8 @@ fn untimed(row: &serde_json::Value) -> String {
         "ratio_to_2dr_brute",
         "ratio_to_aa_none",
         "ratio_to_f32",
+        "stage_ms",
+        "speedup",
     ] {
         map.remove(key);
     }

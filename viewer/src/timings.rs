@@ -51,11 +51,13 @@ impl History {
 }
 
 /// The stages of `StageTimes` with their colours, in pipeline order.
-const STAGES: [(&str, Color32); 4] = [
+const STAGES: [(&str, Color32); 6] = [
     ("setup", Color32::from_rgb(0x4e, 0x79, 0xa7)),
     ("traversal", Color32::from_rgb(0xf2, 0x8e, 0x2b)),
     ("coverage", Color32::from_rgb(0xe1, 0x57, 0x59)),
+    ("resolve", Color32::from_rgb(0xed, 0xc9, 0x48)),
     ("shading", Color32::from_rgb(0x59, 0xa1, 0x4f)),
+    ("store", Color32::from_rgb(0x9c, 0x75, 0x5f)),
 ];
 
 /// Colours of the history's lines, in order of first appearance (Tableau 10).
@@ -72,9 +74,16 @@ const SERIES: [Color32; 10] = [
     Color32::from_rgb(0xba, 0xb0, 0xac),
 ];
 
-fn stage_ms(stats: &Stats) -> [f64; 4] {
+fn stage_ms(stats: &Stats) -> [f64; 6] {
     let t = &stats.time_ms;
-    [t.setup, t.traversal, t.coverage, t.shading]
+    [
+        t.setup,
+        t.traversal,
+        t.coverage,
+        t.resolve,
+        t.shading,
+        t.store,
+    ]
 }
 
 /// Horizontal bars of each stage's time for each labelled render (A, and B in

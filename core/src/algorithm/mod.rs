@@ -25,12 +25,12 @@ use rayon::prelude::*;
 use crate::aa::SamplePattern;
 use crate::camera::View;
 use crate::edge::{CurvedTriangle, Triangle3D, Triangle3D64};
-use crate::framebuffer::{Framebuffer, ResolvedTile, TileBuffer};
+use crate::framebuffer::{Framebuffer, TileBuffer, TilePlanes, TileTotals};
 use crate::ground::{FieldError, PixelRect};
 use crate::pipeline::{EdgeKind, Pipeline, SampleOracles, TraversalOracles};
 use crate::precision::Precision;
 use crate::prepared::PreparedScene;
-use crate::resolve::resolve_tile;
+use crate::resolve::{resolve_tile, shade_tile};
 use crate::screen_boxes::ScreenBoxes;
 use crate::shade::Shader;
 use crate::stats::{CoverageHistogram, RasterCounters, Stats};
@@ -110,6 +110,7 @@ pub(crate) fn run(
         }
         Pipeline::Gpu => return render_gpu(scene, context, fb, stats),
     };
+    stats.time_ms.store += pass.store_ms;
     stats.counters = pass.counters;
     stats.coverage_histogram = pass.histogram;
     stats.shading_samples = pass.shading_samples;
@@ -164,13 +165,15 @@ fn render_frusta<'a, T: crate::edge::Coverage>(
     let start = Instant::now();
     let boxes = ScreenBoxes::new(scene, context.view);
     let boxes = &boxes;
-    let done: Vec<_> = fb
-        .tile_rects(oracles.frustum)
+    let mut pass = Pass::default();
+    let rects = fb.tile_rects(oracles.frustum, oracles.frustum);
+    let done: Vec<_> = pass
+        .planes(fb, &rects)
         .into_par_iter()
         .map_init(
             || None,
-            |cache, rect| {
-                context.run_tile(cache, rect, |tile| {
+            |cache, planes| {
+                context.run_tile(cache, planes, |tile| {
                     let mut t = Traversal::new(scene, context.view, oracles, tile, setup, boxes);
                     t.run();
                     (t.counters, t.nodes_visited, t.setups)
@@ -178,19 +181,15 @@ fn render_frusta<'a, T: crate::edge::Coverage>(
             },
         )
         .collect();
-    let mut pass = Pass::default();
-    pass.store(
-        fb,
-        done.into_iter().map(|finished| {
-            let (counters, nodes, setups) = finished.result;
-            stats.bvh_nodes_visited += nodes;
-            stats.triangle_setups += setups;
-            finished.map(|_| counters)
-        }),
-    );
-    let (traversal, shading) = pass.split(start.elapsed().as_secs_f64() * 1e3);
+    pass.add(done.into_iter().map(|finished| {
+        let (counters, nodes, setups) = finished.result;
+        stats.bvh_nodes_visited += nodes;
+        stats.triangle_setups += setups;
+        finished.map(|_| counters)
+    }));
+    let [traversal, resolve, shading] = pass.split(start);
     stats.time_ms.traversal = traversal;
-    stats.time_ms.shading = shading;
+    (stats.time_ms.resolve, stats.time_ms.shading) = (resolve, shading);
     pass
 }
 
@@ -206,9 +205,9 @@ fn timed_tiles<T: crate::edge::Coverage + Sync>(
     let start = Instant::now();
     let (pass, placed) = rasterize_tiled(items, fb, samples, context);
     stats.triangle_setups = placed;
-    let (coverage, shading) = pass.split(start.elapsed().as_secs_f64() * 1e3);
+    let [coverage, resolve, shading] = pass.split(start);
     stats.time_ms.coverage = coverage;
-    stats.time_ms.shading = shading;
+    (stats.time_ms.resolve, stats.time_ms.shading) = (resolve, shading);
     pass
 }
 
@@ -229,68 +228,71 @@ pub(crate) struct TileContext<'a> {
 /// A tile rendered and resolved by one worker, with what its rendering returned.
 #[derive(Debug)]
 pub(crate) struct Finished<R> {
-    pub resolved: ResolvedTile,
+    pub totals: TileTotals,
     pub result: R,
     /// Edge tests decided past f32 while rendering, `[f64 + exact, exact]`.
     pub precise: [u64; 2],
-    /// Worker seconds spent rendering and resolving.
-    pub render_s: f64,
-    pub resolve_s: f64,
+    /// Worker seconds spent rendering, resolving and shading.
+    pub seconds: [f64; 3],
 }
 
 impl<R> Finished<R> {
     fn map<S>(self, f: impl FnOnce(R) -> S) -> Finished<S> {
         Finished {
-            resolved: self.resolved,
+            totals: self.totals,
             result: f(self.result),
             precise: self.precise,
-            render_s: self.render_s,
-            resolve_s: self.resolve_s,
+            seconds: self.seconds,
         }
     }
 }
 
 impl<'a> TileContext<'a> {
-    /// Renders the pixels of `rect` with `render`,
-    /// then resolves their samples. The sample buffers are `cache`'s, reused
-    /// from the worker's previous tile when there is one (no fresh pages to
-    /// fault in per tile).
+    /// Renders the pixels of `planes.rect` with `render`, then resolves and
+    /// shades their samples straight into the frame's `planes`. The sample
+    /// buffers are `cache`'s, reused from the worker's previous tile when
+    /// there is one (no fresh pages to fault in per tile).
     pub fn run_tile<R: Default>(
         &self,
         cache: &mut Option<TileBuffer<'a>>,
-        rect: PixelRect,
+        mut planes: TilePlanes,
         render: impl FnOnce(&mut TileBuffer<'a>) -> R,
     ) -> Finished<R> {
-        // A cancelled render neither renders nor resolves what is left.
+        // A cancelled render neither renders nor resolves what is left (its
+        // frame is not returned).
         if self.cancel.load(std::sync::atomic::Ordering::Relaxed) {
             return Finished {
-                resolved: ResolvedTile::blank(rect),
+                totals: TileTotals::default(),
                 result: R::default(),
                 precise: [0; 2],
-                render_s: 0.0,
-                resolve_s: 0.0,
+                seconds: [0.0; 3],
             };
         }
         let start = Instant::now();
         let tile = match cache {
             Some(tile) => {
-                tile.reset(rect);
+                tile.reset(planes.rect);
                 tile
             }
-            None => cache.insert(TileBuffer::new(rect, self.pattern, self.opacity)),
+            None => cache.insert(TileBuffer::new(planes.rect, self.pattern, self.opacity)),
         };
         let precise = crate::edge::precise_tests();
         let result = render(tile);
         let precise_after = crate::edge::precise_tests();
-        let render_s = start.elapsed().as_secs_f64();
-        let start = Instant::now();
-        let resolved = resolve_tile(tile, self.view, &self.shader);
+        let rendered = Instant::now();
+        let histogram = resolve_tile(tile, &mut planes);
+        let resolved = Instant::now();
+        let totals = TileTotals {
+            histogram,
+            ..shade_tile(tile, self.view, &self.shader, &mut planes)
+        };
+        let shaded = Instant::now();
         Finished {
-            resolved,
+            totals,
             result,
             precise: [0, 1].map(|k| precise_after[k] - precise[k]),
-            render_s,
-            resolve_s: start.elapsed().as_secs_f64(),
+            seconds: [rendered - start, resolved - rendered, shaded - resolved]
+                .map(|d| d.as_secs_f64()),
         }
     }
 }
@@ -302,42 +304,50 @@ pub(crate) struct Pass {
     pub histogram: CoverageHistogram,
     pub shading_samples: u64,
     pub effects: crate::effects::EffectCounters,
-    render_s: f64,
-    resolve_s: f64,
+    /// Worker seconds rendering, resolving and shading, over all tiles.
+    seconds: [f64; 3],
+    /// Milliseconds spent cutting the frame into tiles.
+    store_ms: f64,
 }
 
 impl Pass {
-    /// Adds up the finished tiles' counters and stores their pixels.
-    pub fn store(
+    /// The frame's planes cut into the tiles of `rects` (the time it takes
+    /// counted as the frame's `store`).
+    pub fn planes<'f>(
         &mut self,
-        fb: &mut Framebuffer,
-        finished: impl IntoIterator<Item = Finished<RasterCounters>>,
-    ) {
-        let resolved: Vec<ResolvedTile> = finished
-            .into_iter()
-            .map(|finished| {
-                self.counters += finished.result;
-                self.counters.edge_tests_f64 += finished.precise[0];
-                self.counters.edge_tests_exact += finished.precise[1];
-                self.histogram += finished.resolved.histogram;
-                self.shading_samples += finished.resolved.shading_samples;
-                self.effects.add(&finished.resolved.effects);
-                self.render_s += finished.render_s;
-                self.resolve_s += finished.resolve_s;
-                finished.resolved
-            })
-            .collect();
-        fb.store_tiles(&resolved);
+        fb: &'f mut Framebuffer,
+        rects: &[PixelRect],
+    ) -> Vec<TilePlanes<'f>> {
+        let start = Instant::now();
+        let planes = fb.tile_planes(rects);
+        self.store_ms += start.elapsed().as_secs_f64() * 1e3;
+        planes
     }
 
-    /// The pass's wall time split into rendering and shading (with the resolve)
-    /// in proportion to the worker time each took: workers do both, tile by tile.
-    pub fn split(&self, wall_ms: f64) -> (f64, f64) {
-        let busy = self.render_s + self.resolve_s;
-        if busy <= 0.0 {
-            return (wall_ms, 0.0);
+    /// Adds up the finished tiles' counters.
+    pub fn add(&mut self, finished: impl IntoIterator<Item = Finished<RasterCounters>>) {
+        for finished in finished {
+            self.counters += finished.result;
+            self.counters.edge_tests_f64 += finished.precise[0];
+            self.counters.edge_tests_exact += finished.precise[1];
+            self.histogram += finished.totals.histogram;
+            self.shading_samples += finished.totals.shading_samples;
+            self.effects.add(&finished.totals.effects);
+            for (sum, s) in self.seconds.iter_mut().zip(finished.seconds) {
+                *sum += s;
+            }
         }
-        let shading = wall_ms * self.resolve_s / busy;
-        (wall_ms - shading, shading)
+    }
+
+    /// The wall time since `start`, less the cutting into tiles, split into
+    /// rendering, resolving and shading in proportion to the worker time
+    /// each took (workers do all three, tile by tile), in milliseconds.
+    pub fn split(&self, start: Instant) -> [f64; 3] {
+        let wall_ms = start.elapsed().as_secs_f64() * 1e3 - self.store_ms;
+        let busy: f64 = self.seconds.iter().sum();
+        if busy <= 0.0 {
+            return [wall_ms, 0.0, 0.0];
+        }
+        self.seconds.map(|s| wall_ms * s / busy)
     }
 }

@@ -57,33 +57,25 @@ pub(crate) fn render_raycast<'a, T: Coverage + Send + Sync>(
 
     // 2. Rays per sample, bands of rows in parallel, each resolved by its worker.
     let start = Instant::now();
-    let bands: Vec<(u32, u32)> = (0..fb.height)
-        .step_by(BAND_ROWS as usize)
-        .map(|y0| (y0, (y0 + BAND_ROWS).min(fb.height)))
-        .collect();
-    let width = fb.width;
-    let done: Vec<_> = bands
+    let mut pass = Pass::default();
+    let bands = fb.tile_rects(fb.width, BAND_ROWS);
+    let done: Vec<_> = pass
+        .planes(fb, &bands)
         .into_par_iter()
         .map_init(
             || None,
-            |cache, (y0, y1)| {
-                context.run_tile(cache, PixelRect::new(0, y0, width, y1), |tile| {
-                    cast_band(scene, view, &setups, tile)
-                })
+            |cache, planes| {
+                context.run_tile(cache, planes, |tile| cast_band(scene, view, &setups, tile))
             },
         )
         .collect();
-    let mut pass = Pass::default();
-    pass.store(
-        fb,
-        done.into_iter().map(|finished| {
-            stats.bvh_nodes_visited += finished.result;
-            finished.map(|_| Default::default())
-        }),
-    );
-    let (traversal, shading) = pass.split(start.elapsed().as_secs_f64() * 1e3);
+    pass.add(done.into_iter().map(|finished| {
+        stats.bvh_nodes_visited += finished.result;
+        finished.map(|_| Default::default())
+    }));
+    let [traversal, resolve, shading] = pass.split(start);
     stats.time_ms.traversal = traversal;
-    stats.time_ms.shading = shading;
+    (stats.time_ms.resolve, stats.time_ms.shading) = (resolve, shading);
     pass
 }
 

@@ -64,14 +64,16 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
 
     // 2. Tiles in parallel, in input order within a tile, each resolved by
     // its worker (the samples never outlive their tile).
-    let rects = fb.tile_rects(TILE);
-    let done: Vec<_> = rects
-        .par_iter()
+    let rects = fb.tile_rects(TILE, TILE);
+    let mut pass = Pass::default();
+    let done: Vec<_> = pass
+        .planes(fb, &rects)
+        .into_par_iter()
         .enumerate()
         .map_init(
             || None,
-            |cache, (t, &rect)| {
-                context.run_tile(cache, rect, |tile| {
+            |cache, (t, planes)| {
+                context.run_tile(cache, planes, |tile| {
                     let mut counters = RasterCounters::default();
                     for &k in &members[offsets[t] as usize..offsets[t + 1] as usize] {
                         // Only placed slots were sorted into tiles.
@@ -88,7 +90,6 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
             },
         )
         .collect();
-    let mut pass = Pass::default();
-    pass.store(fb, done);
+    pass.add(done);
     (pass, placed)
 }

@@ -22,7 +22,7 @@ use crate::camera::View;
 use crate::framebuffer::{Framebuffer, TileBuffer};
 use crate::ground::PixelRect;
 use crate::prepared::PreparedScene;
-use crate::resolve::resolve_tile;
+use crate::resolve::{resolve_tile, shade_tile};
 use crate::shade::Shader;
 use crate::stats::Stats;
 
@@ -522,11 +522,14 @@ pub(crate) fn render_gpu_raster(
     tile.triangle_id = samples.triangle_id;
     tile.depth = samples.depth;
     tile.coverage_writes = samples.fragments.into_iter().map(u32::from).collect();
-    let resolved = resolve_tile(&tile, view, shader);
-    stats.effects = resolved.effects.report(shader.plan(), &scene.scene);
-    stats.coverage_histogram = resolved.histogram;
-    stats.shading_samples = resolved.shading_samples;
-    fb.store_tiles(std::slice::from_ref(&resolved));
+    let whole = [PixelRect::new(0, 0, view.width, view.height)];
+    let [mut planes] = <[_; 1]>::try_from(fb.tile_planes(&whole)).expect("one tile");
+    stats.coverage_histogram = resolve_tile(&tile, &mut planes);
+    stats.time_ms.resolve = start.elapsed().as_secs_f64() * 1e3;
+    let start = Instant::now();
+    let totals = shade_tile(&tile, view, shader, &mut planes);
+    stats.effects = totals.effects.report(shader.plan(), &scene.scene);
+    stats.shading_samples = totals.shading_samples;
     stats.time_ms.shading = start.elapsed().as_secs_f64() * 1e3;
     Ok(())
 }

@@ -8,6 +8,7 @@
 //! identical colours, whatever depth their family computed. Colours are
 //! linear until the resolve ([`crate::aa`]) encodes the filtered pixel as sRGB.
 
+pub(crate) mod eight;
 pub(crate) mod secondary;
 
 use std::time::Instant;
@@ -53,6 +54,9 @@ pub struct Shader<'a> {
     light_terms: Vec<(LightFrom, Vec3)>,
     rays: Rays<'a>,
     t_min: f32,
+    /// Per material: are its samples shaded by [`Shader::shade_eight`]
+    /// (a planar view, no texture, vertex colours, mirror or shadow ray)?
+    lane_materials: Vec<bool>,
 }
 
 impl<'a> Shader<'a> {
@@ -73,7 +77,21 @@ impl<'a> Shader<'a> {
                 };
                 (toward, Vec3::from(light.color).min(Vec3::ONE))
             })
-            .collect();
+            .collect::<Vec<_>>();
+        let mesh = &scene.scene.mesh;
+        let lanes_fit = view.sphere.is_none()
+            && plan.shadow_lights.is_empty()
+            && mesh.colors.is_empty()
+            && light_terms.iter().all(|(_, color)| color.is_finite());
+        let lane_materials = match lanes_fit {
+            false => Vec::new(),
+            true => (scene.scene.materials.iter())
+                .map(|m| {
+                    (m.base_color_texture.is_none() || mesh.uvs.is_empty())
+                        && m.reflectivity.clamp(0.0, 1.0) == 0.0
+                })
+                .collect(),
+        };
         Shader {
             scene,
             view,
@@ -83,6 +101,7 @@ impl<'a> Shader<'a> {
             light_terms,
             rays: Rays::new(scene),
             t_min: scene.bounds.radius().max(f32::MIN_POSITIVE) * SECONDARY_OFFSET,
+            lane_materials,
         }
     }
 

@@ -12,8 +12,8 @@ use super::peer::run_peer;
 use anyhow::Context;
 use continuum::metrics::{self, ImageError};
 use continuum::{
-    AaMode, AlgorithmId, Camera, Framebuffer, Precision, PreparedScene, RenderRequest, View, maps,
-    render,
+    AaMode, AlgorithmId, Camera, Framebuffer, Precision, PreparedScene, RenderRequest, StageTimes,
+    View, maps, render,
 };
 use serde_json::{Value, json};
 
@@ -230,10 +230,14 @@ fn time_interleaved(
         .collect::<Result<Vec<_>, CliError>>()?;
     for _ in 0..repeat {
         for (request, (out, times)) in requests.iter().zip(&mut timed) {
+            // The previous frame's memory serves the next render, as in the
+            // service and the viewer.
+            std::mem::replace(&mut out.framebuffer, Framebuffer::new(0, 0)).recycle();
             *out = render_one(request)?;
             let t = out.stats.time_ms;
             times.total.push(t.total);
-            times.visibility.push(t.total - t.shading);
+            times.visibility.push(t.total - t.resolve - t.shading);
+            times.stages.push(t);
         }
     }
     Ok(timed)
@@ -245,6 +249,21 @@ fn time_interleaved(
 struct Times {
     total: Vec<f64>,
     visibility: Vec<f64>,
+    stages: Vec<StageTimes>,
+}
+
+/// Each stage's median over the rounds.
+fn median_stages(rounds: &[StageTimes]) -> StageTimes {
+    let m = |stage: fn(&StageTimes) -> f64| super::median(rounds.iter().map(stage).collect()).0;
+    StageTimes {
+        setup: m(|t| t.setup),
+        traversal: m(|t| t.traversal),
+        coverage: m(|t| t.coverage),
+        resolve: m(|t| t.resolve),
+        shading: m(|t| t.shading),
+        store: m(|t| t.store),
+        total: m(|t| t.total),
+    }
 }
 
 /// The row of an algorithm from its last render and the times of its rounds.
@@ -270,6 +289,7 @@ fn algorithm_row(
     );
     row.hashes = serde_json::to_value(&out.hashes).unwrap_or(Value::Null);
     row.visibility_ms = Some(super::median(times.visibility).0);
+    row.stage_ms = Some(median_stages(&times.stages));
     row.precision = cell.precision;
     row.shading_samples = out.stats.shading_samples;
     row.coverage_samples = out.stats.coverage_samples;

@@ -57,9 +57,10 @@ pub struct CompareArgs {
     /// Timed runs per scene and algorithm, after one warm-up run [default: 3].
     #[arg(long)]
     repeat: Option<u32>,
-    /// Worker threads [default: all cores].
-    #[arg(long)]
-    threads: Option<u32>,
+    /// Worker threads, comma-separated: each count measures every cell, and
+    /// rows report their speed-up over the smallest [default: all cores].
+    #[arg(long, value_delimiter = ',')]
+    threads: Vec<u32>,
     /// Anti-aliasing modes, comma-separated (none, ssaa:4|16|64|256,
     /// msaa:2|4|8|16, csaa:CxS with C in 4, 8, 16 and S in 1, 2, 4, 8 below C);
     /// each is measured against a ssaa:256 reference and plotted in aa_cost.svg
@@ -117,11 +118,19 @@ pub struct Row {
     pub ratio_to_2dr_brute: Option<f64>,
     pub predicted_ratio: Option<f64>,
     pub rays_per_second: f64,
-    /// The median render without its shading stage: finding what each sample
+    /// The median render without its resolve and shading stages: finding what each sample
     /// sees (setup, traversal, binning, coverage) — what the peers, which
     /// shade nothing, are timed doing.
     #[serde(default)]
     pub visibility_ms: Option<f64>,
+    /// Each stage's median time over the timed rounds (continuum's own
+    /// algorithms): where the frame's time goes.
+    #[serde(default)]
+    pub stage_ms: Option<continuum::StageTimes>,
+    /// With several thread counts in the run: the time at the smallest count
+    /// over this row's (same scene, cell and algorithm).
+    #[serde(default)]
+    pub speedup: Option<f64>,
     pub stats: Value,
     pub hashes: Value,
     /// Does the triangle-id buffer equal its family's reference (for peers and
@@ -176,6 +185,8 @@ impl Row {
             predicted_ratio: None,
             rays_per_second: f64::from(width) * f64::from(height) / (median_ms / 1e3),
             visibility_ms: None,
+            stage_ms: None,
+            speedup: None,
             stats: Value::Null,
             hashes: Value::Null,
             agrees: false,
@@ -240,13 +251,15 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         other => other,
     })?;
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
-    let threads = sweep
-        .threads
-        .map_or_else(rayon::current_num_threads, |t| t as usize);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("building the thread pool")?;
+    let threads = match sweep.threads.as_slice() {
+        [] => vec![rayon::current_num_threads()],
+        counts => counts.to_vec(),
+    };
+    let pools = (threads.iter())
+        .map(|&t| rayon::ThreadPoolBuilder::new().num_threads(t).build())
+        .collect::<Result<Vec<_>, _>>()
+        .context("building the thread pools")?;
+    let widest = pools.last().context("one thread pool at least")?;
 
     // 1. The cells this run measures.
     let cells: Vec<sweep::Cell> = sweep
@@ -254,7 +267,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         .into_iter()
         .filter(|c| args.shard.is_none_or(|s| s.takes(c)))
         .collect();
-    let steps = (cells.len() * sweep.entries.len()) as u64;
+    let steps = (cells.len() * sweep.entries.len() * pools.len()) as u64;
     let progress = indicatif::ProgressBar::new(steps).with_style(
         indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} [{elapsed}]")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
@@ -267,20 +280,22 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             progress.set_message(format!("{}: preparing", cell.scene));
             loaded = Some((
                 cell.scene.clone(),
-                LoadedScene::load(&cell.scene, &sweep, &dir, &pool)?,
+                LoadedScene::load(&cell.scene, &sweep, &dir, widest)?,
             ));
         }
         let Some((_, scene)) = &mut loaded else {
             continue;
         };
-        rows.extend(measure_cell(cell, scene, &sweep, &pool, &out, &progress)?);
+        for pool in &pools {
+            rows.extend(measure_cell(cell, scene, &sweep, pool, &out, &progress)?);
+        }
     }
     progress.finish_and_clear();
     relate(&mut rows);
 
     // 3. The outputs.
     let meta = json!({
-        "machine": machine(threads),
+        "machine": machine(&threads),
         "command": std::env::args().collect::<Vec<_>>().join(" "),
         "sweep": sweep.file,
         "shard": args.shard,
@@ -310,7 +325,11 @@ fn sweep_from_flags(args: &CompareArgs) -> SweepFile {
         precision: list(&args.precision),
         size: args.size.clone(),
         repeat: args.repeat,
-        threads: args.threads,
+        threads: match args.threads.as_slice() {
+            [] => None,
+            [one] => Some(sweep::Threads::One(*one)),
+            many => Some(sweep::Threads::Each(many.to_vec())),
+        },
         camera: args.camera.clone(),
     }
 }
@@ -321,7 +340,14 @@ fn sweep_from_flags(args: &CompareArgs) -> SweepFile {
 /// predicted instructions), to the same algorithm without anti-aliasing, and
 /// to the same algorithm at f32.
 pub fn relate(rows: &mut [Row]) {
-    let key = |r: &Row| (r.scene.clone(), r.viewport.clone(), r.camera.clone());
+    let key = |r: &Row| {
+        (
+            r.scene.clone(),
+            r.viewport.clone(),
+            r.camera.clone(),
+            r.threads,
+        )
+    };
     let brute: HashMap<_, (f64, Option<f64>)> = rows
         .iter()
         .filter(|r| r.algorithm == "2dr-brute" && r.precision == Precision::F32)
@@ -340,7 +366,25 @@ pub fn relate(rows: &mut [Row]) {
         .filter(|r| r.precision == Precision::F32)
         .map(|r| ((key(r), r.algorithm.clone(), r.aa.clone()), r.median_ms))
         .collect();
+    // The same measurement at the run's smallest thread count.
+    let same = |r: &Row| {
+        let (scene, camera) = (r.scene.clone(), r.camera.clone());
+        let what = (r.algorithm.clone(), r.aa.clone(), r.precision);
+        (scene, r.viewport.clone(), camera, what)
+    };
+    let mut fewest: HashMap<_, (usize, f64)> = HashMap::new();
+    for r in rows.iter() {
+        let entry = fewest.entry(same(r)).or_insert((r.threads, r.median_ms));
+        if r.threads < entry.0 {
+            *entry = (r.threads, r.median_ms);
+        }
+    }
+    let several = rows.iter().any(|r| r.threads != rows[0].threads);
     for r in rows.iter_mut() {
+        r.speedup = several
+            .then(|| fewest.get(&same(r)))
+            .flatten()
+            .map(|(_, ms)| ms / r.median_ms);
         let base = brute.get(&(key(r), r.aa.clone()));
         r.ratio_to_2dr_brute = base.map(|(ms, _)| r.median_ms / ms);
         r.predicted_ratio = base.and_then(|(_, instructions)| {
@@ -478,7 +522,7 @@ fn merge(args: &MergeArgs) -> Result<(), CliError> {
 
 /// The machine a run measured on: CPU, cores, threads, OS, the GPU adapter
 /// (when built with it and one opens), the SIMD kernels and continuum's version.
-fn machine(threads: usize) -> Value {
+fn machine(threads: &[usize]) -> Value {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|t| {
@@ -490,7 +534,10 @@ fn machine(threads: usize) -> Value {
     json!({
         "cpu": cpu,
         "logical_cores": std::thread::available_parallelism().map_or(0, |n| n.get()),
-        "threads": threads,
+        "threads": match threads {
+            [one] => json!(one),
+            many => json!(many),
+        },
         "os": std::env::consts::OS,
         "arch": std::env::consts::ARCH,
         "continuum_version": env!("CARGO_PKG_VERSION"),
@@ -508,7 +555,7 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
     let mut f =
         std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
     let mut text = String::from(
-        "scene,algorithm,camera,viewport,aa,precision,width,height,threads,median_ms,min_ms,max_ms,ratio_to_2dr_brute,predicted_ratio,rays_per_second,triangle_setups,edge_evaluations,bvh_nodes_visited,agrees,pixels_differing_from_3dr_brute,triangle_id_hash,ratio_to_aa_none,ratio_to_f32,shading_samples,coverage_samples,psnr,psnr_edges,flip_mean,visibility_ms\n",
+        "scene,algorithm,camera,viewport,aa,precision,width,height,threads,median_ms,min_ms,max_ms,ratio_to_2dr_brute,predicted_ratio,rays_per_second,triangle_setups,edge_evaluations,bvh_nodes_visited,agrees,pixels_differing_from_3dr_brute,triangle_id_hash,ratio_to_aa_none,ratio_to_f32,shading_samples,coverage_samples,psnr,psnr_edges,flip_mean,visibility_ms,setup_ms,traversal_ms,coverage_ms,resolve_ms,shading_ms,store_ms,speedup\n",
     );
     let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.4}"));
     for r in rows {
@@ -519,7 +566,7 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
                 .map_or(String::new(), |v| v.to_string())
         };
         text.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{:.0},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{:.0},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             r.scene,
             r.algorithm,
             r.camera,
@@ -553,6 +600,12 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
             opt(r.psnr_edges),
             r.flip_mean.map_or(String::new(), |v| format!("{v:.6}")),
             opt(r.visibility_ms),
+            r.stage_ms.map_or(",,,,,".to_string(), |t| {
+                [t.setup, t.traversal, t.coverage, t.resolve, t.shading, t.store]
+                    .map(|ms| format!("{ms:.4}"))
+                    .join(",")
+            }),
+            opt(r.speedup),
         ));
     }
     f.write_all(text.as_bytes())
@@ -566,15 +619,18 @@ fn table_text(rows: &[Row]) -> String {
     let mut out = String::new();
     writeln!(
         out,
-        "{:<12} {:<18} {:<16} {:<10} {:<5} {:>10} {:>8} {:>9} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
+        "{:<16} {:<18} {:<16} {:<10} {:<5} {:>3} {:>10} {:>8} {:>9} {:>7} {:>7} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
         "scene",
         "algorithm",
         "viewport",
         "aa",
         "prec",
+        "thr",
         "median ms",
         "ratio",
         "predicted",
+        "frame%",
+        "speedup",
         "x none",
         "x f32",
         "PSNR dB",
@@ -587,15 +643,19 @@ fn table_text(rows: &[Row]) -> String {
         let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.2}"));
         writeln!(
             out,
-            "{:<12} {:<18} {:<16} {:<10} {:<5} {:>10.2} {:>8} {:>9} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
+            "{:<16} {:<18} {:<16} {:<10} {:<5} {:>3} {:>10.2} {:>8} {:>9} {:>7} {:>7} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
             r.scene,
             r.algorithm,
             r.viewport,
             r.aa,
             r.precision,
+            r.threads,
             r.median_ms,
             opt(r.ratio_to_2dr_brute),
             opt(r.predicted_ratio),
+            r.stage_ms
+                .map_or("-".to_string(), |t| format!("{:.1}", 100.0 * frame_share(&t))),
+            opt(r.speedup),
             opt(r.ratio_to_aa_none),
             opt(r.ratio_to_f32),
             opt(r.psnr),
@@ -609,6 +669,15 @@ fn table_text(rows: &[Row]) -> String {
         .ok();
     }
     out
+}
+
+/// The share of a render's time spent on the frame around its algorithm:
+/// resolve, shading and store over the total.
+pub fn frame_share(t: &continuum::StageTimes) -> f64 {
+    if t.total <= 0.0 {
+        return 0.0;
+    }
+    (t.resolve + t.shading + t.store) / t.total
 }
 
 #[cfg(feature = "gpu")]

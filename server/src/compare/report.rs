@@ -56,6 +56,8 @@ pre {{ background: #f7f7f7; padding: 8px; font-size: 11px; overflow-x: auto; }}
         h.push_str("</ul>\n");
     }
     fig9(&mut h, rows);
+    stages(&mut h, rows);
+    threads(&mut h, rows);
     edge_maps(&mut h, rows, maps_root);
     if let Some(svg) = aa_svg {
         let _ = write!(
@@ -108,8 +110,21 @@ fn groups(rows: &[Row]) -> Vec<Vec<&Row>> {
     for r in rows {
         match out.iter_mut().find(|g| {
             let f = g[0];
-            (&f.scene, &f.viewport, &f.camera, &f.aa, f.precision)
-                == (&r.scene, &r.viewport, &r.camera, &r.aa, r.precision)
+            (
+                &f.scene,
+                &f.viewport,
+                &f.camera,
+                &f.aa,
+                f.precision,
+                f.threads,
+            ) == (
+                &r.scene,
+                &r.viewport,
+                &r.camera,
+                &r.aa,
+                r.precision,
+                r.threads,
+            )
         }) {
             Some(g) => g.push(r),
             None => out.push(vec![r]),
@@ -199,6 +214,120 @@ fn fig9(h: &mut String, rows: &[Row]) {
     }
 }
 
+/// The stages of a render, in the order they run, and their colours.
+const STAGES: [(&str, &str); 6] = [
+    ("setup", "#4e79a7"),
+    ("traversal", "#59a14f"),
+    ("coverage", "#76b7b2"),
+    ("resolve", "#edc948"),
+    ("shading", "#e15759"),
+    ("store", "#9c755f"),
+];
+
+/// Fig. 9 split by stage: per group, each of continuum's algorithms as one
+/// bar of its median stage times (ms), so a reader sees where its time goes;
+/// the frame around the algorithm (resolve, shading, store) as a share.
+fn stages(h: &mut String, rows: &[Row]) {
+    let legend: String = STAGES
+        .iter()
+        .map(|(name, color)| format!("<span style=\"color:{color}\">■</span> {name} "))
+        .collect();
+    let _ = writeln!(
+        h,
+        "<h2 id=\"stages\">Where the time goes (Fig. 9 by stage)</h2>\n<p>Median milliseconds of each stage over the timed rounds; the rest of a bar to its total (view and shader setup) is left blank. {legend}</p>"
+    );
+    for group in groups(rows) {
+        let bars: Vec<(&Row, continuum::StageTimes)> = group
+            .iter()
+            .filter_map(|r| Some((*r, r.stage_ms?)))
+            .collect();
+        if bars.is_empty() {
+            continue;
+        }
+        let f = group[0];
+        let _ = writeln!(
+            h,
+            "<h3>{} — {} {} {} {}×{}, {} threads</h3>",
+            escape(&f.scene),
+            escape(&f.viewport),
+            escape(&f.aa),
+            f.precision,
+            f.width,
+            f.height,
+            f.threads
+        );
+        let max = bars
+            .iter()
+            .map(|(_, t)| t.total)
+            .fold(f64::MIN_POSITIVE, f64::max);
+        let (label_w, plot_w, row_h) = (170.0, 620.0, 18.0);
+        let height = bars.len() as f64 * row_h + 12.0;
+        let _ = writeln!(
+            h,
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{}" height="{height}" font-family="sans-serif" font-size="11">"#,
+            label_w + plot_w + 150.0
+        );
+        for (k, (r, t)) in bars.iter().enumerate() {
+            let y = 6.0 + k as f64 * row_h;
+            let _ = writeln!(
+                h,
+                r#"<text x="{}" y="{}" text-anchor="end">{}</text>"#,
+                label_w - 6.0,
+                y + 11.0,
+                escape(&r.algorithm)
+            );
+            let values = [
+                t.setup,
+                t.traversal,
+                t.coverage,
+                t.resolve,
+                t.shading,
+                t.store,
+            ];
+            let mut x = label_w;
+            for ((name, color), ms) in STAGES.iter().zip(values) {
+                let w = plot_w * ms.max(0.0) / max;
+                let _ = writeln!(
+                    h,
+                    r#"<rect x="{x:.1}" y="{y}" width="{w:.1}" height="13" fill="{color}"><title>{name}: {ms:.2} ms</title></rect>"#
+                );
+                x += w;
+            }
+            let _ = writeln!(
+                h,
+                r#"<text x="{:.1}" y="{}">{:.1} ms, frame {:.0}%</text>"#,
+                label_w + plot_w * t.total / max + 4.0,
+                y + 11.0,
+                t.total,
+                100.0 * super::frame_share(t)
+            );
+        }
+        h.push_str("</svg>\n");
+    }
+}
+
+/// With several thread counts: each row's time and its speed-up over the
+/// run's smallest count.
+fn threads(h: &mut String, rows: &[Row]) {
+    if rows.iter().all(|r| r.speedup.is_none()) {
+        return;
+    }
+    h.push_str("<h2 id=\"threads\">Threads</h2>\n<p>Speed-up: the median time at the run's smallest thread count over the median at this count (same scene, viewport, mode, precision and algorithm).</p>\n<table><tr><th class=\"l\">scene</th><th class=\"l\">algorithm</th><th class=\"l\">aa</th><th>threads</th><th>median ms</th><th>speed-up</th></tr>\n");
+    for r in rows.iter().filter(|r| r.speedup.is_some()) {
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{}</td><td>{:.2}</td><td>{}</td></tr>",
+            escape(&r.scene),
+            escape(&r.algorithm),
+            escape(&r.aa),
+            r.threads,
+            r.median_ms,
+            opt(r.speedup, 2)
+        );
+    }
+    h.push_str("</table>\n");
+}
+
 /// Fig. 1 right: every algorithm's edge evaluations per pixel, side by side.
 fn edge_maps(h: &mut String, rows: &[Row], maps_root: &Path) {
     let _ = writeln!(
@@ -243,7 +372,7 @@ fn peers(h: &mut String, rows: &[Row]) {
     if !rows.iter().any(peer) {
         return;
     }
-    h.push_str("<h2 id=\"peers\">Peers</h2>\n<p>peer-obvhs (obvhs's own traversal and triangle test), peer-embree (one rtcIntersect1 per ray), peer-embree-stream (coherent row streams), gpu-raster (the GPU's pipeline through wgpu; lavapipe without a GPU) beside raycast and 3dr-full. Peers are not watertight: their pixels differing from 3dr-brute are reported, not asserted. Peers find the visible triangle and shade nothing; <em>visibility</em> is continuum's render without its shading stage, timed the same way.</p>\n<table><tr><th class=\"l\">scene</th><th class=\"l\">algorithm</th><th>median ms</th><th>× 2dr-brute</th><th>Mrays/s</th><th>visibility ms</th><th>visibility Mrays/s</th><th>pixels ≠ 3dr-brute</th></tr>\n");
+    h.push_str("<h2 id=\"peers\">Peers</h2>\n<p>peer-obvhs (obvhs's own traversal and triangle test), peer-embree (one rtcIntersect1 per ray), peer-embree-stream (coherent row streams), gpu-raster (the GPU's pipeline through wgpu; lavapipe without a GPU) beside raycast and 3dr-full. Peers are not watertight: their pixels differing from 3dr-brute are reported, not asserted. Peers find the visible triangle and shade nothing; <em>visibility</em> is continuum's render without its resolve and shading stages, timed the same way.</p>\n<table><tr><th class=\"l\">scene</th><th class=\"l\">algorithm</th><th>median ms</th><th>× 2dr-brute</th><th>Mrays/s</th><th>visibility ms</th><th>visibility Mrays/s</th><th>pixels ≠ 3dr-brute</th></tr>\n");
     for group in groups(rows) {
         if !group.iter().any(|r| peer(r)) {
             continue;

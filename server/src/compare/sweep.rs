@@ -12,7 +12,7 @@
 //! precision = ["f32", "f64"]                           # default: f32
 //! size = "1280x720"
 //! repeat = 3
-//! threads = 2                                          # default: all cores
+//! threads = [1, 2]                                     # or one count; default: all cores
 //! camera = "front"                                     # default: each scene's first
 //! ```
 //! Unknown keys and bad values are errors naming the key.
@@ -37,8 +37,16 @@ pub struct SweepFile {
     pub precision: Option<Vec<String>>,
     pub size: Option<String>,
     pub repeat: Option<u32>,
-    pub threads: Option<u32>,
+    pub threads: Option<Threads>,
     pub camera: Option<String>,
+}
+
+/// The sweep file's `threads`: one count or a list of counts, each measured.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum Threads {
+    One(u32),
+    Each(Vec<u32>),
 }
 
 /// What one row measures.
@@ -95,7 +103,9 @@ pub struct Sweep {
     pub precisions: Vec<Precision>,
     pub size: (u32, u32),
     pub repeat: u32,
-    pub threads: Option<u32>,
+    /// Worker-thread counts, each measured over every cell, smallest first
+    /// (empty: one run on all cores).
+    pub threads: Vec<usize>,
     pub camera: Option<String>,
     /// Is any mode not `none` (then every scene gets an `ssaa:256` reference)?
     pub with_reference: bool,
@@ -170,11 +180,19 @@ impl Sweep {
         if !(1..=1000).contains(&repeat) {
             return Err(bad("repeat", format!("{repeat} is not in 1..=1000")));
         }
-        if let Some(t) = file.threads
-            && !(1..=1024).contains(&t)
-        {
+        let mut threads = match &file.threads {
+            None => Vec::new(),
+            Some(Threads::One(t)) => vec![*t],
+            Some(Threads::Each(list)) if list.is_empty() => {
+                return Err(bad("threads", "an empty list".into()));
+            }
+            Some(Threads::Each(list)) => list.clone(),
+        };
+        if let Some(t) = threads.iter().find(|t| !(1..=1024).contains(*t)) {
             return Err(bad("threads", format!("{t} is not in 1..=1024")));
         }
+        threads.sort_unstable();
+        threads.dedup();
         Ok(Sweep {
             scenes,
             entries,
@@ -185,7 +203,7 @@ impl Sweep {
             precisions,
             size,
             repeat,
-            threads: file.threads,
+            threads: threads.into_iter().map(|t| t as usize).collect(),
             camera: file.camera.clone(),
             file,
         })

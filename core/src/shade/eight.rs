@@ -1,0 +1,255 @@
+//! Eight samples shaded at once: [`Shader::shade`]'s local shading — the
+//! shaded point on the triangle's plane, the §3.2 barycentrics, the
+//! interpolated normal, Lambert over every light, base colour and emission —
+//! on lanes, for the samples of a planar view whose material asks for nothing
+//! else (no texture, vertex colours, mirror or shadow ray).
+//!
+//! Every lane performs the IEEE operations of the scalar path (glam's `Vec3`:
+//! `dot` as `(x·x' + y·y') + z·z'`, `cross`, `1 / sqrt` for normalizing) in the
+//! same order with no fused multiply-add, so a lane's colour is the scalar
+//! colour bit for bit. Lanes that meet one of the scalar path's special cases
+//! (a ray along the plane, degenerate barycentrics, a zero vertex normal, a
+//! normal or light vector that does not normalize, a NaN) are not shaded
+//! here: the caller shades them with [`Shader::shade`].
+
+use glam::Vec3;
+
+use super::{AMBIENT, LightFrom, Shader};
+use crate::simd::Lanes;
+
+/// Three lanes of f32: eight vectors.
+#[derive(Clone, Copy)]
+struct V3<L> {
+    x: L,
+    y: L,
+    z: L,
+}
+
+impl<L: Lanes> V3<L> {
+    #[inline(always)]
+    fn splat(v: Vec3) -> Self {
+        V3 {
+            x: L::splat(v.x),
+            y: L::splat(v.y),
+            z: L::splat(v.z),
+        }
+    }
+
+    #[inline(always)]
+    fn of(v: &[Vec3; 8]) -> Self {
+        V3 {
+            x: L::from_array(v.map(|v| v.x)),
+            y: L::from_array(v.map(|v| v.y)),
+            z: L::from_array(v.map(|v| v.z)),
+        }
+    }
+
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        V3 {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
+    }
+
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        V3 {
+            x: self.x - o.x,
+            y: self.y - o.y,
+            z: self.z - o.z,
+        }
+    }
+
+    #[inline(always)]
+    fn scale(self, s: L) -> Self {
+        V3 {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
+    }
+
+    #[inline(always)]
+    fn dot(self, o: Self) -> L {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+
+    #[inline(always)]
+    fn cross(self, o: Self) -> Self {
+        V3 {
+            x: self.y * o.z - o.y * self.z,
+            y: self.z * o.x - o.z * self.x,
+            z: self.x * o.y - o.x * self.y,
+        }
+    }
+
+    /// glam's `normalize_or`: `self · (1 / |self|)`, and the lanes where
+    /// that reciprocal is finite and positive (elsewhere the scalar path
+    /// takes a fallback).
+    #[inline(always)]
+    fn normalized(self) -> (Self, u8) {
+        let rcp = L::splat(1.0) / self.dot(self).sqrt();
+        let ok = finite(rcp) & rcp.gt(L::splat(0.0));
+        (self.scale(rcp), ok)
+    }
+}
+
+/// `v0 + vx·x + vy·y` on lanes, as `View::direction` and `View::origin_offset`
+/// evaluate it.
+#[inline(always)]
+fn along<L: Lanes>([v0, vx, vy]: [Vec3; 3], x: L, y: L) -> V3<L> {
+    V3::splat(v0)
+        .add(V3::splat(vx).scale(x))
+        .add(V3::splat(vy).scale(y))
+}
+
+/// The lit share of a base colour channel: `AMBIENT + (1 − AMBIENT)·lit`.
+#[inline(always)]
+fn ambient<L: Lanes>(lit: L) -> L {
+    L::splat(AMBIENT) + L::splat(1.0 - AMBIENT) * lit
+}
+
+/// The lanes holding a finite value (`v · 0` is ±0 exactly there, NaN elsewhere).
+#[inline(always)]
+fn finite<L: Lanes>(v: L) -> u8 {
+    let zero = L::splat(0.0);
+    (v * zero).eq(zero)
+}
+
+/// Eight samples of one row: triangle ids, pixel positions and the lanes to shade.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct EightSamples {
+    pub ids: [u32; 8],
+    pub x: [f32; 8],
+    pub y: f32,
+    /// Lanes holding a triangle whose material [`Shader::shades_in_lanes`].
+    pub lanes: u8,
+}
+
+impl Shader<'_> {
+    /// Whether triangle `id`'s samples can be shaded by [`Shader::shade_eight`].
+    #[inline(always)]
+    pub(crate) fn shades_in_lanes(&self, id: u32) -> bool {
+        let material = self.scene.scene.mesh.material_ids[id as usize];
+        self.lane_materials.get(material as usize) == Some(&true)
+    }
+
+    /// The linear colour [`Shader::shade`] gives each lane of `s`, and the
+    /// lanes it holds: those of `s.lanes` that met none of the scalar path's
+    /// special cases (see the module documentation).
+    #[inline(always)]
+    pub(crate) fn shade_eight<L: Lanes>(&self, s: &EightSamples) -> ([Vec3; 8], u8) {
+        let prepared = self.scene;
+        let mesh = &prepared.scene.mesh;
+        let interpolated = !mesh.normals.is_empty();
+        debug_assert!(s.lanes != 0, "at least one lane to shade");
+        let mut done = s.lanes;
+        // 1. What each lane's triangle brings (lanes without one repeat the
+        // first that has one, so that every lane computes on real values).
+        let first = s.ids[done.trailing_zeros() as usize];
+        let mut corners = [[Vec3::ZERO; 8]; 3];
+        let mut vertex_normals = [[Vec3::ZERO; 8]; 3];
+        let mut face = [Vec3::ZERO; 8];
+        let mut base = [Vec3::ZERO; 8];
+        let mut emissive = [Vec3::ZERO; 8];
+        for l in 0..8 {
+            let id = if done & (1 << l) != 0 {
+                s.ids[l]
+            } else {
+                first
+            } as usize;
+            let p = &prepared.triangles[id];
+            for k in 0..3 {
+                corners[k][l] = p[k];
+            }
+            face[l] = prepared.face_normals[id];
+            let material = &prepared.scene.materials[mesh.material_ids[id] as usize];
+            base[l] = Vec3::from_slice(&material.base_color[..3]);
+            emissive[l] = Vec3::from(material.emissive);
+            if interpolated {
+                for (k, &v) in mesh.triangles[id].iter().enumerate() {
+                    vertex_normals[k][l] = mesh.normals[v as usize];
+                }
+                if (0..3).any(|k| vertex_normals[k][l] == Vec3::ZERO) {
+                    done &= !(1 << l);
+                }
+            }
+        }
+        let (p0, p1, p2) = (
+            V3::<L>::of(&corners[0]),
+            V3::of(&corners[1]),
+            V3::of(&corners[2]),
+        );
+
+        // 2. The ray through each sample (`View::origin`, `View::direction`).
+        let view = self.view;
+        let (x, y) = (L::from_array(s.x), L::splat(s.y));
+        let dir = along([view.d0, view.dx, view.dy], x, y);
+        let origin = V3::splat(view.eye).add(along([view.o0, view.ox, view.oy], x, y));
+
+        // 3. Where the ray meets the triangle's plane (`plane_distance`).
+        let normal = p1.sub(p0).cross(p2.sub(p0));
+        let denom = normal.dot(dir);
+        let t = normal.dot(p0.sub(origin)) / denom;
+        done &= !denom.eq(L::splat(0.0)) & finite(t);
+        let point = origin.add(dir.scale(t));
+
+        // 4. The shading normal, facing the ray (`shading_normal`).
+        let facing = V3::of(&face);
+        let flip = facing.dot(dir).gt(L::splat(0.0));
+        let toward = L::from_array(std::array::from_fn(|l| match flip & (1 << l) {
+            0 => 1.0,
+            _ => -1.0,
+        }));
+        let normal = if interpolated {
+            // The §3.2 barycentrics `V_i / ΣV` (`barycentrics`).
+            let q = [p0.sub(origin), p1.sub(origin), p2.sub(origin)];
+            let v0 = q[1].cross(q[2]).dot(dir);
+            let v1 = q[2].cross(q[0]).dot(dir);
+            let v2 = q[0].cross(q[1]).dot(dir);
+            let total = v0 + v1 + v2;
+            done &= !total.eq(L::splat(0.0)) & finite(total);
+            let n0 = V3::<L>::of(&vertex_normals[0]).scale(v0 / total);
+            let n1 = V3::<L>::of(&vertex_normals[1]).scale(v1 / total);
+            let n2 = V3::<L>::of(&vertex_normals[2]).scale(v2 / total);
+            let n = n0.add(n1).add(n2);
+            let (n, ok) = n.normalized();
+            done &= ok;
+            n.scale(toward)
+        } else {
+            facing.scale(toward)
+        };
+
+        // 5. Lambert over the lights, or a headlight at the eye.
+        let zero = L::splat(0.0);
+        let mut lit = V3::splat(Vec3::ZERO);
+        if self.light_terms.is_empty() {
+            let (d, ok) = dir.normalized();
+            done &= ok;
+            let s = normal.dot(d.scale(L::splat(-1.0))).max(zero);
+            lit = V3 { x: s, y: s, z: s };
+        }
+        for &(from, color) in &self.light_terms {
+            let to_light = match from {
+                LightFrom::Direction(toward) => V3::splat(toward),
+                LightFrom::Position(position) => {
+                    let (to, ok) = V3::splat(position).sub(point).normalized();
+                    done &= ok;
+                    to
+                }
+            };
+            let lambert = normal.dot(to_light);
+            // A lane whose term the scalar path skips (`lambert ≤ 0`) adds
+            // `color · 0`, which leaves its sum as it is; a NaN goes scalar.
+            done &= lambert.eq(lambert);
+            lit = lit.add(V3::splat(color).scale(lambert.max(zero)));
+        }
+        let (base, emissive) = (V3::<L>::of(&base), V3::<L>::of(&emissive));
+        let r = (base.x * ambient(lit.x) + emissive.x).to_array();
+        let g = (base.y * ambient(lit.y) + emissive.y).to_array();
+        let b = (base.z * ambient(lit.z) + emissive.z).to_array();
+        (std::array::from_fn(|l| Vec3::new(r[l], g[l], b[l])), done)
+    }
+}
