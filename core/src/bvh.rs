@@ -98,8 +98,19 @@ impl SceneBvh {
                 &mut Duration::default(),
             )
         };
+        let mut cwbvh = cwbvh;
+        // The builder reserves for the worst case; keep what the tree holds.
+        cwbvh.nodes.shrink_to_fit();
+        cwbvh.primitive_indices.shrink_to_fit();
         let child_boxes = cwbvh.nodes.iter().map(decode_children).collect();
         SceneBvh { cwbvh, child_boxes }
+    }
+
+    /// Heap bytes held: the nodes, the primitive order and the decoded child boxes.
+    pub fn bytes(&self) -> usize {
+        self.cwbvh.nodes.capacity() * std::mem::size_of::<CwBvhNode>()
+            + self.cwbvh.primitive_indices.capacity() * 4
+            + self.child_boxes.capacity() * std::mem::size_of::<ChildBoxes>()
     }
 
     /// Checks obvhs's structural invariants against the primitive boxes; panics on

@@ -26,7 +26,10 @@ pub fn covered_samples(triangles: &[Triangle3D], width: u32, height: u32, isa: I
 /// Checks the scene's BVH against its triangles (every drawable triangle in
 /// exactly one leaf, every box holding its children); panics on a fault.
 pub fn validate_bvh(scene: &PreparedScene) {
-    scene.bvh.validate(&scene.triangles, &scene.drawable);
+    let triangles: Vec<_> = (0..scene.triangle_count() as u32)
+        .map(|id| scene.triangle(id))
+        .collect();
+    scene.bvh.validate(&triangles, &scene.drawable);
 }
 
 #[cfg(target_arch = "x86_64")]

@@ -17,8 +17,6 @@ use crate::texture::MipChain;
 #[derive(Debug)]
 pub struct PreparedScene {
     pub scene: Arc<Scene>,
-    /// Vertex positions per triangle id.
-    pub triangles: Vec<[Vec3; 3]>,
     /// Unit geometric normal per triangle id (zero for degenerate triangles).
     pub(crate) face_normals: Vec<Vec3>,
     /// Ids of the triangles that are drawn: all but the degenerate ones (two equal
@@ -33,6 +31,10 @@ pub struct PreparedScene {
     /// gathering from the mesh.
     pub(crate) slot_corners: Vec<[Vec3; 3]>,
     pub(crate) slot_vertices: Vec<[u32; 3]>,
+    /// Per triangle id: its BVH slot ([`NO_SLOT`] for a degenerate triangle),
+    /// so that [`PreparedScene::triangle`] reads the slot-ordered corners
+    /// instead of a second copy in id order.
+    pub(crate) slot_of: Vec<u32>,
     pub bounds: Bounds,
     /// Near distance for cameras that give none: 1e-3 of the bounding radius.
     pub default_near: f32,
@@ -85,6 +87,11 @@ impl PreparedScene {
             .par_iter()
             .map(|&id| mesh.triangles[id as usize])
             .collect();
+        let mut slot_of = vec![NO_SLOT; triangles.len()];
+        for (slot, &id) in slot_triangles.iter().enumerate() {
+            slot_of[id as usize] = slot as u32;
+        }
+        drop(triangles);
         let bounds = scene.bounds();
         let radius = if bounds.is_empty() {
             1.0
@@ -114,13 +121,13 @@ impl PreparedScene {
         PreparedScene {
             textures,
             triangle_opacity,
-            triangles,
             face_normals,
             drawable,
             bvh,
             slot_triangles,
             slot_corners,
             slot_vertices,
+            slot_of,
             bounds,
             default_near: radius * 1e-3,
             scene,
@@ -129,26 +136,33 @@ impl PreparedScene {
         }
     }
 
-    /// Approximate heap size in bytes (for cache bounds).
-    pub fn approx_bytes(&self) -> usize {
+    /// Heap bytes this prepared scene holds, its mesh included: every
+    /// buffer's allocated capacity (the GPU's copy, held by the driver, is
+    /// not counted). What `stats.scene_bytes_per_triangle` reports and the
+    /// service's scene cache bounds.
+    pub fn bytes(&self) -> usize {
+        fn held<T>(v: &Vec<T>) -> usize {
+            v.capacity() * std::mem::size_of::<T>()
+        }
         let mesh = &self.scene.mesh;
-        mesh.positions.len() * 12
-            + mesh.normals.len() * 12
-            + mesh.uvs.len() * 8
-            + mesh.triangles.len() * 16
-            + self.triangles.len() * 36
-            + self.face_normals.len() * 12
-            + self.drawable.len() * 4
-            + self.slot_triangles.len() * (4 + 36 + 12)
-            + self.triangle_opacity.len() * 4
-            + self.bvh.cwbvh.nodes.len() * (80 + 192)
-            + self.bvh.cwbvh.primitive_indices.len() * 4
-            + self
-                .textures
-                .iter()
-                .flatten()
-                .map(|t| t.texel_count() * 16)
-                .sum::<usize>()
+        let textures: usize = (self.textures.iter().flatten())
+            .map(|t| t.texel_count() * 16)
+            .sum();
+        held(&mesh.positions)
+            + held(&mesh.normals)
+            + held(&mesh.uvs)
+            + held(&mesh.colors)
+            + held(&mesh.triangles)
+            + held(&mesh.material_ids)
+            + held(&self.face_normals)
+            + held(&self.drawable)
+            + held(&self.slot_triangles)
+            + held(&self.slot_corners)
+            + held(&self.slot_vertices)
+            + held(&self.slot_of)
+            + held(&self.triangle_opacity)
+            + self.bvh.bytes()
+            + textures
     }
 
     /// Whether triangle `id` is see-through (its material's opacity below 1).
@@ -159,9 +173,21 @@ impl PreparedScene {
 
     /// Triangle count, degenerate ones included.
     pub fn triangle_count(&self) -> usize {
-        self.triangles.len()
+        self.scene.mesh.triangle_count()
+    }
+
+    /// The vertex positions of triangle `id` (any id, degenerate ones too).
+    #[inline(always)]
+    pub fn triangle(&self, id: u32) -> [Vec3; 3] {
+        match self.slot_of[id as usize] {
+            NO_SLOT => self.scene.mesh.triangle_positions(id as usize),
+            slot => self.slot_corners[slot as usize],
+        }
     }
 }
+
+/// [`PreparedScene::slot_of`] of a triangle the BVH does not hold.
+const NO_SLOT: u32 = u32::MAX;
 
 /// Whether triangle `id` is see-through under the per-triangle `opacity`
 /// (empty: every triangle opaque).

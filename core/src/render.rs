@@ -136,6 +136,7 @@ pub fn render_cancellable(
     let (setup_cost, sample_cost) = pipeline.instruction_costs();
     stats.predicted_instructions =
         stats.triangle_setups * setup_cost + stats.edge_evaluations * sample_cost;
+    stats.scene_bytes_per_triangle = scene.bytes() as f64 / scene.triangle_count().max(1) as f64;
     let hashes = Hashes::of(&fb);
     stats.time_ms.store += start.elapsed().as_secs_f64() * 1e3;
     stats.time_ms.total = total.elapsed().as_secs_f64() * 1e3;

@@ -87,6 +87,9 @@ pub struct Stats {
     /// The paper's Fig. 10 model: setups × setup cost + edge evaluations × per-sample
     /// cost (2D 72/14, homogeneous 73/14, 3D 57/12 scalar instructions).
     pub predicted_instructions: u64,
+    /// Heap bytes of the prepared scene (mesh, per-triangle data, BVH,
+    /// textures) per triangle, after this render built what it needs.
+    pub scene_bytes_per_triangle: f64,
     /// The effects the scene called for and what each cost (empty when it
     /// calls for none).
     pub effects: Vec<crate::effects::EffectStats>,

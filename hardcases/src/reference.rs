@@ -146,7 +146,7 @@ fn reference_triangles(scene: &PreparedScene, view: &View) -> Vec<RefTriangle> {
     let mut tris = Vec::with_capacity(scene.drawable.len());
     let mut keys = Vec::with_capacity(scene.drawable.len());
     for &id in &scene.drawable {
-        let world = scene.triangles[id as usize];
+        let world = scene.triangle(id);
         let p = world.map(|v| v.as_dvec3() - eye);
         let normal = (p[1] - p[0]).cross(p[2] - p[0]);
         let facing = if view.is_orthographic() {

@@ -83,7 +83,7 @@ impl Cache {
     /// the total fits `max_bytes`.
     fn insert(&mut self, name: &str, scene: Arc<PreparedScene>, uploaded: bool, max_bytes: usize) {
         self.clock += 1;
-        let bytes = scene.approx_bytes();
+        let bytes = scene.bytes();
         self.entries.insert(
             name.to_string(),
             Cached {

@@ -184,7 +184,7 @@ fn pixel_geometry(
     x: f64,
     y: f64,
 ) -> PixelGeometry {
-    let p = scene.triangles[id as usize].map(|v| v.as_dvec3());
+    let p = scene.triangle(id).map(|v| v.as_dvec3());
     if view.is_orthographic() {
         return pixel_geometry_orthographic(view, p, x, y);
     }

@@ -154,7 +154,7 @@ fn pieces_of<T>(
 ) -> [Option<Placed<T>>; MAX_CLIPPED - 2] {
     let mut pieces: [Option<Placed<T>>; MAX_CLIPPED - 2] = std::array::from_fn(|_| None);
     // 1. Transform and clip.
-    let p = &scene.triangles[id as usize];
+    let p = scene.triangle(id);
     let cam = p.map(|v| view.to_camera_f64(v));
     let Some(poly) = clip_triangle(cam, planes) else {
         return pieces;

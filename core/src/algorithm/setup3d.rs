@@ -166,7 +166,7 @@ fn setup_visible<'a, T: Send>(
         .map(|ids| {
             let id = lanes_of(ids).map(|&id| id as usize);
             let mut eight = EightTriangles {
-                corners: id.map(|id| &scene.triangles[id]),
+                corners: id.map(|id| &scene.slot_corners[scene.slot_of[id] as usize]),
                 vertices: id.map(|id| corners[id]),
                 present: 0,
             };

@@ -266,7 +266,7 @@ impl Gpu {
         let mut positions = Vec::with_capacity(vertices as usize * 12);
         let mut ids = Vec::with_capacity(vertices as usize * 4);
         for &id in &scene.drawable {
-            for p in &scene.triangles[id as usize] {
+            for p in &scene.triangle(id) {
                 positions.extend(p.to_array().iter().flat_map(|v| v.to_le_bytes()));
                 ids.extend(id.to_le_bytes());
             }

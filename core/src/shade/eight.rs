@@ -160,7 +160,7 @@ impl Shader<'_> {
             } else {
                 first
             } as usize;
-            let p = &prepared.triangles[id];
+            let p = prepared.triangle(id as u32);
             for k in 0..3 {
                 corners[k][l] = p[k];
             }

@@ -142,7 +142,7 @@ impl<'a> Shader<'a> {
         // family's own depth), so every algorithm that finds the triangle
         // shades it alike — the 2D family included.
         let (origin, dir) = ray;
-        let t = plane_distance(&self.scene.triangles[id as usize], origin, dir).unwrap_or(depth);
+        let t = plane_distance(&self.scene.triangle(id), origin, dir).unwrap_or(depth);
         self.shade_surface(id, Some(at), origin, dir, t, 0, effects)
     }
 
@@ -171,7 +171,7 @@ impl<'a> Shader<'a> {
         // The §3.2 barycentrics, once per sample, when normals, texture
         // coordinates or vertex colours are interpolated.
         let lambda = (textured || !mesh.normals.is_empty() || !mesh.colors.is_empty())
-            .then(|| barycentrics(&self.scene.triangles[id as usize], origin, dir));
+            .then(|| barycentrics(&self.scene.triangle(id), origin, dir));
         let normal = self.shading_normal(id, lambda, dir);
 
         // 1. Direct light: Lambert per light, each shadow-casting light's term
@@ -270,7 +270,7 @@ impl<'a> Shader<'a> {
         lambda: [f32; 3],
     ) -> (glam::Vec4, u32) {
         let mesh = &self.scene.scene.mesh;
-        let corners = &self.scene.triangles[id as usize];
+        let corners = &self.scene.triangle(id);
         let [a, b, c] = mesh.triangles[id as usize];
         let uv_of = |l: [f32; 3]| {
             mesh.uvs[a as usize] * l[0] + mesh.uvs[b as usize] * l[1] + mesh.uvs[c as usize] * l[2]

@@ -118,7 +118,7 @@ impl<'a> Rays<'a> {
             if id != skip
                 && !scene.is_transparent(id)
                 && let Some((t, lambda)) = intersect(
-                    &scene.triangles[id as usize],
+                    &scene.slot_corners[slot as usize],
                     origin,
                     dir,
                     t_min,
@@ -150,7 +150,14 @@ impl<'a> Rays<'a> {
             let id = scene.slot_triangles[slot as usize];
             if passed > 0.0
                 && id != skip
-                && intersect(&scene.triangles[id as usize], origin, dir, t_min, t_max).is_some()
+                && intersect(
+                    &scene.slot_corners[slot as usize],
+                    origin,
+                    dir,
+                    t_min,
+                    t_max,
+                )
+                .is_some()
             {
                 passed *= scene
                     .triangle_opacity

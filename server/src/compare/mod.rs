@@ -555,7 +555,7 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
     let mut f =
         std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
     let mut text = String::from(
-        "scene,algorithm,camera,viewport,aa,precision,width,height,threads,median_ms,min_ms,max_ms,ratio_to_2dr_brute,predicted_ratio,rays_per_second,triangle_setups,edge_evaluations,bvh_nodes_visited,agrees,pixels_differing_from_3dr_brute,triangle_id_hash,ratio_to_aa_none,ratio_to_f32,shading_samples,coverage_samples,psnr,psnr_edges,flip_mean,visibility_ms,setup_ms,traversal_ms,coverage_ms,resolve_ms,shading_ms,store_ms,speedup\n",
+        "scene,algorithm,camera,viewport,aa,precision,width,height,threads,median_ms,min_ms,max_ms,ratio_to_2dr_brute,predicted_ratio,rays_per_second,triangle_setups,edge_evaluations,bvh_nodes_visited,agrees,pixels_differing_from_3dr_brute,triangle_id_hash,ratio_to_aa_none,ratio_to_f32,shading_samples,coverage_samples,psnr,psnr_edges,flip_mean,visibility_ms,setup_ms,traversal_ms,coverage_ms,resolve_ms,shading_ms,store_ms,speedup,scene_bytes_per_triangle\n",
     );
     let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.4}"));
     for r in rows {
@@ -566,7 +566,7 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
                 .map_or(String::new(), |v| v.to_string())
         };
         text.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{:.0},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{:.0},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             r.scene,
             r.algorithm,
             r.camera,
@@ -606,6 +606,7 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
                     .join(",")
             }),
             opt(r.speedup),
+            opt(r.stats.get("scene_bytes_per_triangle").and_then(Value::as_f64)),
         ));
     }
     f.write_all(text.as_bytes())
@@ -619,7 +620,7 @@ fn table_text(rows: &[Row]) -> String {
     let mut out = String::new();
     writeln!(
         out,
-        "{:<16} {:<18} {:<16} {:<10} {:<5} {:>3} {:>10} {:>8} {:>9} {:>7} {:>7} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
+        "{:<16} {:<18} {:<16} {:<10} {:<5} {:>3} {:>10} {:>8} {:>9} {:>7} {:>7} {:>6} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
         "scene",
         "algorithm",
         "viewport",
@@ -631,6 +632,7 @@ fn table_text(rows: &[Row]) -> String {
         "predicted",
         "frame%",
         "speedup",
+        "B/tri",
         "x none",
         "x f32",
         "PSNR dB",
@@ -643,7 +645,7 @@ fn table_text(rows: &[Row]) -> String {
         let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.2}"));
         writeln!(
             out,
-            "{:<16} {:<18} {:<16} {:<10} {:<5} {:>3} {:>10.2} {:>8} {:>9} {:>7} {:>7} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
+            "{:<16} {:<18} {:<16} {:<10} {:<5} {:>3} {:>10.2} {:>8} {:>9} {:>7} {:>7} {:>6} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
             r.scene,
             r.algorithm,
             r.viewport,
@@ -656,6 +658,8 @@ fn table_text(rows: &[Row]) -> String {
             r.stage_ms
                 .map_or("-".to_string(), |t| format!("{:.1}", 100.0 * frame_share(&t))),
             opt(r.speedup),
+            (r.stats.get("scene_bytes_per_triangle").and_then(Value::as_f64))
+                .map_or("-".to_string(), |b| format!("{b:.0}")),
             opt(r.ratio_to_aa_none),
             opt(r.ratio_to_f32),
             opt(r.psnr),

@@ -101,7 +101,7 @@ fn run_obvhs(scene: &PreparedScene, view: &View, repeat: u32) -> PeerRun {
         .drawable
         .iter()
         .map(|&i| {
-            let [a, b, c] = scene.triangles[i as usize];
+            let [a, b, c] = scene.triangle(i);
             Triangle {
                 v0: a.into(),
                 v1: b.into(),
@@ -169,7 +169,7 @@ mod embree_peer {
         {
             let mut vertices = mesh.vertex_buffer.map();
             for (k, &id) in scene.drawable.iter().enumerate() {
-                for (j, p) in scene.triangles[id as usize].iter().enumerate() {
+                for (j, p) in scene.triangle(id).iter().enumerate() {
                     vertices[3 * k + j] = Vector4::new(p.x, p.y, p.z, 0.0);
                 }
             }

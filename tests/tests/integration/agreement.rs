@@ -78,7 +78,7 @@ fn triangles_through_eye_plane(
         .drawable
         .iter()
         .filter(|&&id| {
-            let w = scene.triangles[id as usize].map(|p| (p - camera.eye).dot(forward));
+            let w = scene.triangle(id).map(|p| (p - camera.eye).dot(forward));
             w.iter().any(|&v| v < 0.0) && w.iter().any(|&v| v > 0.0)
         })
         .count()

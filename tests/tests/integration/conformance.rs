@@ -64,7 +64,9 @@ enum Expect {
 /// Distance in pixels from `(x, y)` to the nearest edge line of triangle `id`
 /// (a [`pixel_camera`] scene).
 fn edge_distance(scene: &PreparedScene, id: u32, x: f64, y: f64) -> f64 {
-    let p = scene.triangles[id as usize].map(|v| (f64::from(v.x), -f64::from(v.y)));
+    let p = scene
+        .triangle(id)
+        .map(|v| (f64::from(v.x), -f64::from(v.y)));
     (0..3)
         .map(|i| {
             let (a, b) = (p[(i + 1) % 3], p[(i + 2) % 3]);

@@ -175,29 +175,13 @@ fn secondary_rays_from_inside_a_closed_mesh_hit_it_exactly_once() {
             .drawable
             .iter()
             .filter(|&&id| {
-                intersect(
-                    &sphere.triangles[id as usize],
-                    origin,
-                    dir,
-                    0.0,
-                    f32::INFINITY,
-                )
-                .is_some()
+                intersect(&sphere.triangle(id), origin, dir, 0.0, f32::INFINITY).is_some()
             })
             .count();
         assert_eq!(hits, 1, "from {origin} along {dir}");
         // The BVH walk finds that one hit, and the shadow query agrees.
         let hit = rays.closest(origin, dir, 0.0, u32::MAX).expect("a hit");
-        assert!(
-            intersect(
-                &sphere.triangles[hit.id as usize],
-                origin,
-                dir,
-                0.0,
-                f32::INFINITY
-            )
-            .is_some()
-        );
+        assert!(intersect(&sphere.triangle(hit.id), origin, dir, 0.0, f32::INFINITY).is_some());
         assert!(rays.occluded(origin, dir, 0.0, f32::INFINITY, u32::MAX));
         assert!(!rays.occluded(origin, dir, 0.0, hit.t * 0.999, u32::MAX));
     }
