@@ -209,6 +209,8 @@ pub async fn render_json(
         })
         .collect();
     doc["images"] = Value::Object(images);
+    // The next render of this size reuses the frame's memory.
+    out.framebuffer.recycle();
     Ok(Json(doc))
 }
 
@@ -260,7 +262,9 @@ pub async fn render_png(
         e
     })?;
     let (out, _, _) = run(state, checked).await?;
-    Ok(([(header::CONTENT_TYPE, "image/png")], image(&out, &output)).into_response())
+    let png = image(&out, &output);
+    out.framebuffer.recycle();
+    Ok(([(header::CONTENT_TYPE, "image/png")], png).into_response())
 }
 
 /// `GET /api/scenes`: names, triangle counts, cameras, lights and effects of

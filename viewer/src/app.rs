@@ -44,6 +44,16 @@ struct Shown {
 }
 
 impl Shown {
+    /// Gives the frames' memory back for the next renders of their size.
+    fn recycle(self) {
+        if let Ok(rendered) = self.outcome.result {
+            rendered.a.framebuffer.recycle();
+            if let Some(Ok(b)) = rendered.b {
+                b.framebuffer.recycle();
+            }
+        }
+    }
+
     fn output(&self, side: Side) -> Option<&RenderOutput> {
         let rendered = self.outcome.result.as_ref().ok()?;
         match side {
@@ -220,6 +230,10 @@ impl ViewerApp {
                 for out in outputs.into_iter().flatten() {
                     self.history
                         .push(history_label(out), out.stats.time_ms.total);
+                }
+                // The frames shown until now serve the worker's next renders.
+                if let Some(old) = self.shown.take() {
+                    old.recycle();
                 }
                 self.shown = Some(Shown {
                     outcome,
