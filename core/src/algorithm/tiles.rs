@@ -14,6 +14,21 @@ use crate::stats::RasterCounters;
 /// Side of a screen tile in pixels.
 pub(crate) const TILE: u32 = 64;
 
+/// Items per run of the parallel binning.
+const BIN_RUN: usize = 1 << 14;
+
+/// One run's items sorted by tile: tile `t`'s are `members[offsets[t]..offsets[t + 1]]`.
+struct Binned {
+    offsets: Vec<u32>,
+    members: Vec<u32>,
+}
+
+impl Binned {
+    fn of(&self, t: usize) -> &[u32] {
+        &self.members[self.offsets[t] as usize..self.offsets[t + 1] as usize]
+    }
+}
+
 /// A set-up triangle with its screen box and id.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Placed<T> {
@@ -40,27 +55,35 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
             .flat_map(move |ty| (tx0..=tx1).map(move |tx| ty as usize * columns + tx as usize))
     };
 
-    // 1. Counting sort of item indices by tile.
-    let mut offsets = vec![0u32; tile_count + 1];
-    let mut placed = 0;
-    for item in items.iter().flatten() {
-        placed += 1;
-        for t in tiles_of(&item.rect) {
-            offsets[t + 1] += 1;
-        }
-    }
-    for t in 0..tile_count {
-        offsets[t + 1] += offsets[t];
-    }
-    let mut fill = offsets.clone();
-    let mut members = vec![0u32; offsets[tile_count] as usize];
-    for (k, item) in items.iter().enumerate() {
-        let Some(item) = item else { continue };
-        for t in tiles_of(&item.rect) {
-            members[fill[t] as usize] = k as u32;
-            fill[t] += 1;
-        }
-    }
+    // 1. Counting sorts of item indices by tile, one per run of items, in
+    // parallel: a tile's items are its lists of every run, in run order.
+    let runs: Vec<Binned> = items
+        .par_chunks(BIN_RUN)
+        .enumerate()
+        .map(|(run, chunk)| {
+            let base = (run * BIN_RUN) as u32;
+            let mut offsets = vec![0u32; tile_count + 1];
+            for item in chunk.iter().flatten() {
+                for t in tiles_of(&item.rect) {
+                    offsets[t + 1] += 1;
+                }
+            }
+            for t in 0..tile_count {
+                offsets[t + 1] += offsets[t];
+            }
+            let mut fill = offsets.clone();
+            let mut members = vec![0u32; offsets[tile_count] as usize];
+            for (k, item) in chunk.iter().enumerate() {
+                let Some(item) = item else { continue };
+                for t in tiles_of(&item.rect) {
+                    members[fill[t] as usize] = base + k as u32;
+                    fill[t] += 1;
+                }
+            }
+            Binned { offsets, members }
+        })
+        .collect();
+    let placed = items.iter().flatten().count() as u64;
 
     // 2. Tiles in parallel, in input order within a tile, each resolved by
     // its worker (the samples never outlive their tile).
@@ -75,7 +98,8 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
             |cache, (t, planes)| {
                 context.run_tile(cache, planes, |tile| {
                     let mut counters = RasterCounters::default();
-                    for &k in &members[offsets[t] as usize..offsets[t + 1] as usize] {
+                    let members = runs.iter().flat_map(|run| run.of(t));
+                    for &k in members {
                         // Only placed slots were sorted into tiles.
                         let Some(item) = &items[k as usize] else {
                             continue;
