@@ -129,7 +129,7 @@ impl Framebuffer {
     /// Gives this framebuffer's memory to the next render of the same size
     /// (the service, the viewer and `compare` render many frames of one size:
     /// a reused frame costs no page faults and no clearing). The pool keeps
-    /// the [`FRAME_POOL_SIZE`] most recently recycled frames.
+    /// the two most recently recycled frames.
     pub fn recycle(self) {
         let mut pool = FRAME_POOL.lock().unwrap_or_else(|e| e.into_inner());
         if pool.len() == FRAME_POOL_SIZE {
@@ -217,8 +217,9 @@ impl Framebuffer {
     }
 }
 
-/// Frames kept by [`Framebuffer::recycle`].
-pub const FRAME_POOL_SIZE: usize = 4;
+/// Frames kept by [`Framebuffer::recycle`]: two (the viewer shows two at once; the
+/// service renders two at a time), so an idle process holds at most two frames.
+const FRAME_POOL_SIZE: usize = 2;
 
 static FRAME_POOL: std::sync::Mutex<Vec<Framebuffer>> = std::sync::Mutex::new(Vec::new());
 

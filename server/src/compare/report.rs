@@ -247,7 +247,7 @@ fn stages(h: &mut String, rows: &[Row]) {
         let f = group[0];
         let _ = writeln!(
             h,
-            "<h3>{} — {} {} {} {}×{}, {} threads</h3>",
+            "<h3>{} — {} {} {} {}×{}, threads: {}</h3>",
             escape(&f.scene),
             escape(&f.viewport),
             escape(&f.aa),
