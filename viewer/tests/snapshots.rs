@@ -61,7 +61,9 @@ fn pin_times(app: &mut ViewerApp) {
         stats.time_ms.setup = 2.0 * k;
         stats.time_ms.traversal = 3.0 * k;
         stats.time_ms.coverage = 5.0 * k;
-        stats.time_ms.shading = 1.5 * k;
+        stats.time_ms.resolve = 0.5 * k;
+        stats.time_ms.shading = 1.0 * k;
+        stats.time_ms.store = 0.5 * k;
         stats.time_ms.total = 12.0 * k;
     }
     let history = app.history_mut();
