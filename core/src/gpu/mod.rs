@@ -131,6 +131,13 @@ impl Gpu {
             if !usages
                 .contains(wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC)
             {
+                // A refused adapter is kept, not dropped: on Mesa's EGL, wgpu's
+                // teardown and glvnd's thread-state destructor at process exit
+                // can free the same state twice (an abort in about one run in
+                // twenty; gfx-rs/wgpu#4285). `gpu()` opens once per process, so
+                // this keeps one instance at most.
+                std::mem::forget(adapter);
+                std::mem::forget(instance);
                 return Err(GpuError::NoDevice(format!(
                     "the adapter {adapter_name} cannot render to {format:?}"
                 )));
