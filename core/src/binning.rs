@@ -5,6 +5,12 @@
 //! accept it whole, or split it in four, down to a leaf size where samples are
 //! tested one by one. With early-z a block is skipped when the triangle's nearest
 //! possible depth lies behind everything the hierarchical w-buffer holds there.
+//!
+//! **Small triangles** (a box of at most [`SMALL`] samples, every position
+//! stored) skip the hierarchy and are tested on those samples directly, in one
+//! group of lanes across rows, as llvmpipe's and Nanite's small-triangle paths
+//! do: the same sample points through the same [`Coverage`] decision, so the
+//! same image bit for bit; the counters record the tests actually made.
 
 use crate::edge::{BlockTest, Coverage};
 use crate::framebuffer::{SCRATCH_PIXELS, TileBuffer};
@@ -23,7 +29,7 @@ pub(crate) fn raster_triangle<T: Coverage>(
     oracles: SampleOracles,
     counters: &mut RasterCounters,
 ) {
-    if !oracles.binning {
+    if !oracles.binning || is_small(tile, clip) {
         sample_block(tile, tri, id, clip, oracles, counters);
         return;
     }
@@ -37,6 +43,19 @@ pub(crate) fn raster_triangle<T: Coverage>(
     }
     let (bx, by) = (tile.x0 + lx0 / side * side, tile.y0 + ly0 / side * side);
     bin_block(tile, tri, id, clip, bx, by, side, oracles, counters);
+}
+
+/// Samples a box may hold to take the small-triangle path: one group of lanes.
+const SMALL: usize = 8;
+
+/// Does `r` take the small-triangle path: at most [`SMALL`] samples, every
+/// coverage position stored (CSAA's coverage-only positions take the general
+/// path, which gathers their masks per pixel)?
+#[inline]
+fn is_small(tile: &TileBuffer, r: PixelRect) -> bool {
+    let pattern = tile.pattern;
+    !pattern.has_coverage_only()
+        && (r.width() as usize * r.height() as usize) * pattern.coverage() <= SMALL
 }
 
 /// The samples of `r` one by one (the leaf of every strategy), after early-z and
@@ -92,6 +111,20 @@ fn test_samples_on<L: Lanes, T: Coverage>(
     id: u32,
     r: PixelRect,
 ) -> u32 {
+    if r.height() > 1 && is_small(tile, r) {
+        return sample_small::<L, T>(tile, tri, id, r);
+    }
+    sample_rows::<L, T>(tile, tri, id, r)
+}
+
+/// [`test_samples`] row by row: the general path.
+#[inline(always)]
+fn sample_rows<L: Lanes, T: Coverage>(
+    tile: &mut TileBuffer,
+    tri: &T,
+    id: u32,
+    r: PixelRect,
+) -> u32 {
     if tile.pattern.coverage() > 1 {
         return sample_pattern::<L, T>(tile, tri, id, r, Samples::Test);
     }
@@ -110,6 +143,50 @@ fn test_samples_on<L: Lanes, T: Coverage>(
         });
     }
     covered
+}
+
+/// The small-triangle path: every sample of `r` (at most [`SMALL`], every
+/// position stored; see [`is_small`]) in one group of lanes, pixel by pixel
+/// in row order and position by position within a pixel. Each lane's point is
+/// the one the general paths form for that sample (`x + offset` on integer
+/// pixel coordinates, exact in f32), so each decision is theirs. Returns how
+/// many samples the triangle covers.
+#[inline(always)]
+fn sample_small<L: Lanes, T: Coverage>(
+    tile: &mut TileBuffer,
+    tri: &T,
+    id: u32,
+    r: PixelRect,
+) -> u32 {
+    let pattern = tile.pattern;
+    let count = pattern.positions.len();
+    let shift = count.trailing_zeros();
+    let width = r.width() as usize;
+    let total = (width * r.height() as usize) << shift;
+    let (mut xs, mut ys, mut at) = ([0.0; 8], [0.0; 8], [0usize; 8]);
+    for l in 0..8 {
+        // Spare lanes repeat the last sample; their bits are dropped.
+        let s = l.min(total - 1);
+        let (p, c) = (s >> shift, s & (count - 1));
+        let (x, y) = (r.x0 + (p % width) as u32, r.y0 + (p / width) as u32);
+        let [ox, oy] = pattern.positions[c];
+        (xs[l], ys[l]) = (x as f32 + ox, y as f32 + oy);
+        at[l] = c * tile.pixels + tile.index(x, y);
+    }
+    for y in r.y0..r.y1 {
+        let i = tile.index(r.x0, y);
+        for evals in &mut tile.edge_evals[i..i + width] {
+            *evals += count as u32;
+        }
+    }
+    let (mask, w) = tri.sample_points8::<L>(xs, ys, first_lanes(total));
+    let mut covered = mask;
+    while covered != 0 {
+        let l = covered.trailing_zeros() as usize;
+        covered &= covered - 1;
+        tile.write(at[l], w[l], id);
+    }
+    mask.count_ones()
 }
 
 simd::dispatch! {
@@ -320,5 +397,75 @@ fn bin_block<T: Coverage>(
             }
             covered
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::aa::{AaMode, SamplePattern};
+    use crate::edge::{ScreenVertex, Triangle2D};
+    use crate::simd::Portable;
+
+    /// The small-triangle path decides and writes every sample as the
+    /// general row path does: random small triangles, with their neighbours
+    /// sharing the tile (so depth ties and overwrites happen), rasterized
+    /// both ways into one tile each give the same depths, ids, write counts
+    /// and edge-evaluation counts, bit for bit, under every pattern it serves.
+    #[test]
+    fn small_triangles_match_the_general_path() {
+        let mut rng = fastrand::Rng::with_seed(5);
+        let (mut small, mut covered) = (Vec::new(), 0);
+        for aa in ["none", "msaa:2", "msaa:4", "ssaa:4", "msaa:8"] {
+            let pattern = SamplePattern::of(AaMode::parse(aa).unwrap());
+            let rect = PixelRect::new(0, 0, 16, 16);
+            let mut fast = TileBuffer::new(rect, &pattern, &[]);
+            let mut rows = TileBuffer::new(rect, &pattern, &[]);
+            small.push(0);
+            for id in 0..3000 {
+                let centre = [1.0 + 14.0 * rng.f32(), 1.0 + 14.0 * rng.f32()];
+                let size = [0.5, 1.5, 3.0][id as usize % 3];
+                let v: [ScreenVertex; 3] = std::array::from_fn(|_| ScreenVertex {
+                    x: centre[0] + size * (rng.f32() - 0.5),
+                    y: centre[1] + size * (rng.f32() - 0.5),
+                    q: 1.0 / (1.0 + rng.f32()),
+                });
+                let Some(tri) = Triangle2D::setup(&v, false, 16, 16) else {
+                    continue;
+                };
+                let [x0, y0, x1, y1] = tri.bounds;
+                let Some(r) = PixelRect::from_bounds(x0, y0, x1, y1, 16, 16, pattern.span) else {
+                    continue;
+                };
+                if !(r.height() > 1 && is_small(&fast, r)) {
+                    continue;
+                }
+                *small.last_mut().unwrap() += 1;
+                let a = sample_small::<Portable, _>(&mut fast, &tri, id, r);
+                let b = sample_rows::<Portable, _>(&mut rows, &tri, id, r);
+                assert_eq!(a, b, "{aa}: triangle {id} covers");
+                covered += a;
+            }
+            let bits = |v: &[f32]| v.iter().map(|d| d.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&fast.depth), bits(&rows.depth), "{aa}: depth");
+            assert_eq!(fast.triangle_id, rows.triangle_id, "{aa}: ids");
+            assert_eq!(fast.coverage_writes, rows.coverage_writes, "{aa}: writes");
+            assert_eq!(fast.edge_evals, rows.edge_evals, "{aa}: edge evaluations");
+        }
+        // Boxes of at most eight samples over more than one row: up to 2×4
+        // pixels under one sample a pixel, 1×2 boxes under four, none under
+        // eight (which must not take the path).
+        let [none, msaa2, msaa4, ssaa4, msaa8] = small[..] else {
+            unreachable!()
+        };
+        assert!(
+            none > 300 && msaa2 > 300,
+            "small triangles per pattern: {small:?}"
+        );
+        assert!(
+            msaa4 > 100 && ssaa4 > 100 && msaa8 == 0,
+            "small triangles per pattern: {small:?}"
+        );
+        assert!(covered > 1000, "{covered} samples covered");
     }
 }

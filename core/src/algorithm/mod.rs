@@ -72,10 +72,7 @@ pub(crate) fn run(
                 EdgeKind::ThreeD if view.sphere.is_some() => {
                     let mut items = setup3d::setup_curved(scene, view, span);
                     if samples.incremental {
-                        items
-                            .iter_mut()
-                            .flatten()
-                            .for_each(|p| p.tri.incremental = true);
+                        (items.triangles.iter_mut().flatten()).for_each(|t| t.incremental = true);
                     }
                     tiles!(items)
                 }
@@ -194,7 +191,7 @@ fn render_frusta<'a, T: crate::edge::Coverage>(
 }
 
 fn timed_tiles<T: crate::edge::Coverage + Sync>(
-    items: &[Option<tiles::Placed<T>>],
+    items: &tiles::Setups<T>,
     fb: &mut Framebuffer,
     samples: SampleOracles,
     context: &TileContext,
@@ -203,8 +200,8 @@ fn timed_tiles<T: crate::edge::Coverage + Sync>(
 ) -> Pass {
     stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
     let start = Instant::now();
-    let (pass, placed) = rasterize_tiled(items, fb, samples, context);
-    stats.triangle_setups = placed;
+    let pass = rasterize_tiled(items, fb, samples, context);
+    stats.triangle_setups = items.placed();
     let [coverage, resolve, shading] = pass.split(start);
     stats.time_ms.coverage = coverage;
     (stats.time_ms.resolve, stats.time_ms.shading) = (resolve, shading);

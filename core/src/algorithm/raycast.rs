@@ -8,7 +8,8 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use super::setup3d::{self, SetupEight, SlotSetups};
+use super::setup3d::{self, SetupEight};
+use super::tiles::Setups;
 use super::{Pass, PixelRect, TileContext};
 use crate::aa::SamplePattern;
 use crate::bvh::{PACKET, PacketRays};
@@ -52,7 +53,7 @@ pub(crate) fn render_raycast<'a, T: Coverage + Send + Sync>(
     // rasterizers bound their search with: a ray tests a triangle only inside it.
     let start = Instant::now();
     let setups = setup3d::setup_slots(scene, view, context.pattern.span, setup);
-    stats.triangle_setups = setups.boxes.iter().filter(|s| s.is_some()).count() as u64;
+    stats.triangle_setups = setups.placed();
     stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
 
     // 2. Rays per sample, bands of rows in parallel, each resolved by its worker.
@@ -84,7 +85,7 @@ simd::dispatch! {
     fn cast_band<T: Coverage>(
         scene: &PreparedScene,
         view: &View,
-        setups: &SlotSetups<T>,
+        setups: &Setups<T>,
         tile: &mut TileBuffer,
     ) -> u64 => cast_band_on
 }
@@ -99,7 +100,7 @@ simd::dispatch! {
 fn cast_band_on<L: Lanes, T: Coverage>(
     scene: &PreparedScene,
     view: &View,
-    setups: &SlotSetups<T>,
+    setups: &Setups<T>,
     tile: &mut TileBuffer,
 ) -> u64 {
     let pattern = tile.pattern;
@@ -255,7 +256,7 @@ fn directions_lanes<L: Lanes>(
 /// once per triangle.
 #[inline(always)]
 fn stored_masks<L: Lanes, T: Coverage>(
-    setups: &SlotSetups<T>,
+    setups: &Setups<T>,
     slots: &[u32; 8],
     tile: &mut TileBuffer,
     (x, y): (u32, u32),
@@ -318,7 +319,7 @@ fn coverage_mask<L: Lanes, T: Coverage>(tri: &T, pattern: &SamplePattern, x: u32
 fn lost_coverage<L: Lanes, T: Coverage>(
     scene: &PreparedScene,
     view: &View,
-    setups: &SlotSetups<T>,
+    setups: &Setups<T>,
     tile: &mut TileBuffer,
     (x, y): (u32, u32),
 ) -> u64 {

@@ -7,7 +7,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::tiles::Placed;
+use super::tiles::{ItemBox, Setups};
 use crate::camera::View;
 use crate::clip::{
     ClipPlane, GUARD_BAND, MAX_CLIPPED, clip_triangle, fixed_guard_band, pipeline_planes,
@@ -19,11 +19,7 @@ use crate::prepared::PreparedScene;
 
 /// Every drawable triangle, clipped, projected and set up with f32 edge
 /// functions; pieces without samples on screen are dropped.
-pub(crate) fn setup_2d(
-    scene: &PreparedScene,
-    view: &View,
-    span: SampleSpan,
-) -> Vec<Option<Placed<Triangle2D>>> {
+pub(crate) fn setup_2d(scene: &PreparedScene, view: &View, span: SampleSpan) -> Setups<Triangle2D> {
     let affine = view.is_orthographic();
     setup_pieces(scene, view, span, [GUARD_BAND; 2], |v| {
         let t = Triangle2D::setup(v, affine, view.width, view.height)?;
@@ -38,7 +34,7 @@ pub(crate) fn setup_2d_fixed(
     scene: &PreparedScene,
     view: &View,
     span: SampleSpan,
-) -> Vec<Option<Placed<Triangle2DFixed>>> {
+) -> Setups<Triangle2DFixed> {
     let affine = view.is_orthographic();
     setup_pieces(scene, view, span, fixed_guard_band(view), |v| {
         let t = Triangle2DFixed::setup(v, affine)?;
@@ -48,8 +44,8 @@ pub(crate) fn setup_2d_fixed(
 
 /// Clips (the guard band `guard` in units of the half-extents), projects and
 /// fan-triangulates every drawable triangle; `make` sets up each piece and
-/// gives its pixel bounds `[min_x, min_y, max_x, max_y]`. One slot per drawable
-/// triangle holds its first piece (an exactly sized, parallel collect written
+/// gives its pixel bounds `[min_x, min_y, max_x, max_y]`. One item per drawable
+/// triangle holds its first piece (exactly sized, parallel collects written
 /// in place); the further pieces of the few triangles clipping cuts into
 /// several follow, set up again in a second, small pass.
 ///
@@ -64,31 +60,55 @@ fn setup_pieces<T: Send>(
     span: SampleSpan,
     guard: [f32; 2],
     make: impl Fn(&[ScreenVertex; 3]) -> Option<(T, [f32; 4])> + Sync,
-) -> Vec<Option<Placed<T>>> {
+) -> Setups<T> {
     let planes = pipeline_planes(view, guard);
     let kept = screen_vertices(scene, view, &planes);
     let corners = &scene.scene.mesh.triangles;
     let pieces = |id: u32| pieces_of(scene, view, span, &planes, &make, id);
-    let (mut placed, more): (Vec<Option<Placed<T>>>, Vec<bool>) = scene
+    let item = |piece: Option<Piece<T>>| match piece {
+        Some(Piece { tri, rect, id }) => (Some((rect, id)), Some(tri)),
+        None => (None, None),
+    };
+    let (first, more): (Columns<T>, Vec<bool>) = scene
         .drawable
         .par_iter()
         .map(|&id| {
             if let [Some(a), Some(b), Some(c)] = corners[id as usize].map(|v| kept[v as usize]) {
-                return (piece(view, span, &make, &[a, b, c], id), false);
+                return (item(piece(view, span, &make, &[a, b, c], id)), false);
             }
             let mut pieces = pieces(id).into_iter().flatten();
-            (pieces.next(), pieces.next().is_some())
+            (item(pieces.next()), pieces.next().is_some())
         })
         .unzip();
-    let rest: Vec<Option<Placed<T>>> = scene
+    let rest: Vec<(ItemBox, Option<T>)> = scene
         .drawable
         .par_iter()
         .zip(&more)
         .filter(|&(_, &more)| more)
-        .flat_map_iter(|(&id, _)| pieces(id).into_iter().flatten().skip(1).map(Some))
+        .flat_map_iter(|(&id, _)| {
+            pieces(id)
+                .into_iter()
+                .flatten()
+                .skip(1)
+                .map(|p| item(Some(p)))
+        })
         .collect();
-    placed.extend(rest);
-    placed
+    let (mut boxes, mut triangles) = first;
+    for (b, t) in rest {
+        boxes.push(b);
+        triangles.push(t);
+    }
+    Setups { boxes, triangles }
+}
+
+/// Items' boxes and triangles, before they are [`Setups`].
+type Columns<T> = (Vec<ItemBox>, Vec<Option<T>>);
+
+/// One set-up piece of a triangle with its pixels and the triangle's id.
+struct Piece<T> {
+    tri: T,
+    rect: PixelRect,
+    id: u32,
 }
 
 /// Per mesh vertex: its projection when it is inside every clip plane (`None`
@@ -136,10 +156,10 @@ fn piece<T>(
     make: &impl Fn(&[ScreenVertex; 3]) -> Option<(T, [f32; 4])>,
     vertices: &[ScreenVertex; 3],
     id: u32,
-) -> Option<Placed<T>> {
+) -> Option<Piece<T>> {
     let (tri, [x0, y0, x1, y1]) = make(vertices)?;
     let rect = PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height, span)?;
-    Some(Placed { tri, rect, id })
+    Some(Piece { tri, rect, id })
 }
 
 /// The set-up pieces of triangle `id` after clipping and fan triangulation,
@@ -151,8 +171,8 @@ fn pieces_of<T>(
     planes: &[ClipPlane],
     make: &impl Fn(&[ScreenVertex; 3]) -> Option<(T, [f32; 4])>,
     id: u32,
-) -> [Option<Placed<T>>; MAX_CLIPPED - 2] {
-    let mut pieces: [Option<Placed<T>>; MAX_CLIPPED - 2] = std::array::from_fn(|_| None);
+) -> [Option<Piece<T>>; MAX_CLIPPED - 2] {
+    let mut pieces: [Option<Piece<T>>; MAX_CLIPPED - 2] = std::array::from_fn(|_| None);
     // 1. Transform and clip.
     let p = scene.triangle(id);
     let cam = p.map(|v| view.to_camera_f64(v));

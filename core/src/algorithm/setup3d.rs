@@ -5,7 +5,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use super::tiles::Placed;
+use super::tiles::{ItemBox, Setups};
 use crate::camera::View;
 use crate::edge::{
     CurvedTriangle, EightTriangles, HomogeneousVertex, Triangle3D, Triangle3D64,
@@ -21,7 +21,7 @@ pub(crate) fn setup_3d<'a>(
     scene: &'a PreparedScene,
     view: &'a View,
     span: SampleSpan,
-) -> Vec<Option<Placed<Triangle3D<'a>>>> {
+) -> Setups<Triangle3D<'a>> {
     setup_visible(scene, view, span, Triangle3D::setup_eight)
 }
 
@@ -30,7 +30,7 @@ pub(crate) fn setup_3d_f64(
     scene: &PreparedScene,
     view: &View,
     span: SampleSpan,
-) -> Vec<Option<Placed<Triangle3D64>>> {
+) -> Setups<Triangle3D64> {
     setup_visible(scene, view, span, one_by_one(Triangle3D64::setup))
 }
 
@@ -40,7 +40,7 @@ pub(crate) fn setup_curved(
     scene: &PreparedScene,
     view: &View,
     span: SampleSpan,
-) -> Vec<Option<Placed<CurvedTriangle>>> {
+) -> Setups<CurvedTriangle> {
     setup_visible(scene, view, span, one_by_one(CurvedTriangle::setup))
 }
 
@@ -51,7 +51,7 @@ pub(crate) fn setup_homogeneous<'a>(
     scene: &'a PreparedScene,
     view: &'a View,
     span: SampleSpan,
-) -> Vec<Option<Placed<Triangle3D<'a>>>> {
+) -> Setups<Triangle3D<'a>> {
     let points: Vec<HomogeneousVertex> = (scene.scene.mesh.positions.par_iter())
         .map(|&p| HomogeneousVertex::of(p, view))
         .collect();
@@ -82,18 +82,6 @@ pub(crate) fn one_by_one<'a, T>(
     move |t: &EightTriangles<'a>, view: &'a View| t.each(|l| setup(t.corners[l], view))
 }
 
-/// A BVH slot's triangle's screen box and id (`None`: nothing to test).
-pub(crate) type SlotBox = Option<(PixelRect, u32)>;
-
-/// Per BVH slot, its triangle's conservative screen box and id, and apart
-/// from them its edge functions — so a ray caster reads the small box first
-/// and the edge functions only where the box holds its rays. `None` (in
-/// both) for a triangle off screen or edge-on.
-pub(crate) struct SlotSetups<T> {
-    pub boxes: Vec<SlotBox>,
-    pub triangles: Vec<Option<T>>,
-}
-
 /// Every BVH slot's triangle set up by `setup` with its conservative screen
 /// box, in slot order (from the scene's slot-ordered copies of positions and
 /// vertex indices: memory read in order), eight slots at a time.
@@ -102,34 +90,50 @@ pub(crate) fn setup_slots<'a, T: Send>(
     view: &'a View,
     span: SampleSpan,
     setup: impl SetupEight<'a, T>,
-) -> SlotSetups<T> {
+) -> Setups<T> {
     let boxes = ScreenBoxes::new(scene, view);
     let chunks = (scene.slot_corners.par_chunks(8))
         .zip(scene.slot_vertices.par_chunks(8))
         .zip(scene.slot_triangles.par_chunks(8));
-    let (boxes, triangles): (Vec<[SlotBox; 8]>, Vec<[Option<T>; 8]>) = chunks
-        .map(|((p, vertices), ids)| {
-            let (rects, present) =
-                rects_of(p.len(), |l| boxes.rect(&p[l], vertices[l], view, span));
-            let eight = EightTriangles {
-                corners: lanes_of(p),
-                vertices: lanes_of(vertices).map(|v| *v),
-                present,
-            };
-            let triangles = setup(&eight, view);
-            let mut boxes = [None; 8];
-            for l in 0..p.len() {
-                if triangles[l].is_some() {
-                    boxes[l] = rects[l].map(|rect| (rect, ids[l]));
-                }
-            }
-            (boxes, triangles)
-        })
-        .unzip();
+    let eights = chunks.map(|((p, vertices), ids)| {
+        let (rects, present) = rects_of(p.len(), |l| boxes.rect(&p[l], vertices[l], view, span));
+        let eight = EightTriangles {
+            corners: lanes_of(p),
+            vertices: lanes_of(vertices).map(|v| *v),
+            present,
+        };
+        paired(rects, lanes_of(ids), setup(&eight, view))
+    });
+    flattened(eights.unzip(), scene.slot_triangles.len())
+}
+
+/// Eight lanes' boxes (with the triangles' ids) and set-up triangles,
+/// `None` in both where either is.
+#[inline(always)]
+fn paired<T>(
+    rects: [Option<PixelRect>; 8],
+    ids: [&u32; 8],
+    mut triangles: [Option<T>; 8],
+) -> ([ItemBox; 8], [Option<T>; 8]) {
+    let mut boxes = [None; 8];
+    for l in 0..8 {
+        match rects[l] {
+            Some(rect) if triangles[l].is_some() => boxes[l] = Some((rect, *ids[l])),
+            _ => triangles[l] = None,
+        }
+    }
+    (boxes, triangles)
+}
+
+/// The first `len` items of chunks of eight.
+fn flattened<T>(
+    (boxes, triangles): (Vec<[ItemBox; 8]>, Vec<[Option<T>; 8]>),
+    len: usize,
+) -> Setups<T> {
     let (mut boxes, mut triangles) = (boxes.into_flattened(), triangles.into_flattened());
-    boxes.truncate(scene.slot_triangles.len());
-    triangles.truncate(scene.slot_triangles.len());
-    SlotSetups { boxes, triangles }
+    boxes.truncate(len);
+    triangles.truncate(len);
+    Setups { boxes, triangles }
 }
 
 /// Up to eight values as lanes (the last one repeated past the end).
@@ -151,43 +155,29 @@ fn rects_of(n: usize, rect: impl Fn(usize) -> Option<PixelRect>) -> ([Option<Pix
 }
 
 /// Every drawable triangle set up by `setup` with its conservative screen
-/// box: one slot per triangle, in order (an exactly sized, parallel collect
-/// of eight at a time: no chunks to concatenate); `None` for the ones off
+/// box: one item per triangle, in order (exactly sized, parallel collects of
+/// eight at a time: no chunks to concatenate); `None` for the ones off
 /// screen or edge-on.
 fn setup_visible<'a, T: Send>(
     scene: &'a PreparedScene,
     view: &'a View,
     span: SampleSpan,
     setup: impl SetupEight<'a, T>,
-) -> Vec<Option<Placed<T>>> {
+) -> Setups<T> {
     let boxes = ScreenBoxes::new(scene, view);
     let corners = &scene.scene.mesh.triangles;
-    let placed: Vec<[Option<Placed<T>>; 8]> = (scene.drawable.par_chunks(8))
-        .map(|ids| {
-            let id = lanes_of(ids).map(|&id| id as usize);
-            let mut eight = EightTriangles {
-                corners: id.map(|id| &scene.slot_corners[scene.slot_of[id] as usize]),
-                vertices: id.map(|id| corners[id]),
-                present: 0,
-            };
-            let (rects, present) = rects_of(ids.len(), |l| {
-                boxes.rect(eight.corners[l], eight.vertices[l], view, span)
-            });
-            eight.present = present;
-            let mut placed = [const { None }; 8];
-            for (l, tri) in setup(&eight, view).into_iter().enumerate() {
-                if let (Some(tri), Some(rect)) = (tri, rects[l]) {
-                    placed[l] = Some(Placed {
-                        tri,
-                        rect,
-                        id: ids[l],
-                    });
-                }
-            }
-            placed
-        })
-        .collect();
-    let mut placed = placed.into_flattened();
-    placed.truncate(scene.drawable.len());
-    placed
+    let eights = (scene.drawable.par_chunks(8)).map(|ids| {
+        let id = lanes_of(ids).map(|&id| id as usize);
+        let mut eight = EightTriangles {
+            corners: id.map(|id| &scene.slot_corners[scene.slot_of[id] as usize]),
+            vertices: id.map(|id| corners[id]),
+            present: 0,
+        };
+        let (rects, present) = rects_of(ids.len(), |l| {
+            boxes.rect(eight.corners[l], eight.vertices[l], view, span)
+        });
+        eight.present = present;
+        paired(rects, lanes_of(ids), setup(&eight, view))
+    });
+    flattened(eights.unzip(), scene.drawable.len())
 }

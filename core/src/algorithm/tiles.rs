@@ -29,22 +29,35 @@ impl Binned {
     }
 }
 
-/// A set-up triangle with its screen box and id.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Placed<T> {
-    pub tri: T,
-    pub rect: PixelRect,
-    pub id: u32,
+/// An item's conservative screen box and triangle id (`None`: nothing to test).
+pub(crate) type ItemBox = Option<(PixelRect, u32)>;
+
+/// Set-up triangles as two arrays of one item each: the conservative screen
+/// box and id, and apart from them the edge functions (`None` in both for a
+/// triangle off screen, edge-on or degenerate). Binning and a ray caster read
+/// the small boxes alone — 24 bytes an item, where the set-up triangle is
+/// some 100 — and the edge functions only where a box reaches their tile or
+/// their rays.
+pub(crate) struct Setups<T> {
+    pub boxes: Vec<ItemBox>,
+    pub triangles: Vec<Option<T>>,
 }
 
-/// Renders `items` into `fb`, tile by tile in parallel (`None` slots are
-/// triangles the setup dropped); also returns how many were placed.
+impl<T> Setups<T> {
+    /// How many items have something to test.
+    pub(crate) fn placed(&self) -> u64 {
+        self.boxes.iter().flatten().count() as u64
+    }
+}
+
+/// Renders `items` into `fb`, tile by tile in parallel (`None` items are
+/// triangles the setup dropped).
 pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
-    items: &[Option<Placed<T>>],
+    items: &Setups<T>,
     fb: &mut Framebuffer,
     oracles: SampleOracles,
     context: &TileContext,
-) -> (Pass, u64) {
+) -> Pass {
     let columns = fb.width.div_ceil(TILE) as usize;
     let rows = fb.height.div_ceil(TILE) as usize;
     let tile_count = columns * rows;
@@ -57,14 +70,14 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
 
     // 1. Counting sorts of item indices by tile, one per run of items, in
     // parallel: a tile's items are its lists of every run, in run order.
-    let runs: Vec<Binned> = items
+    let runs: Vec<Binned> = (items.boxes)
         .par_chunks(BIN_RUN)
         .enumerate()
         .map(|(run, chunk)| {
             let base = (run * BIN_RUN) as u32;
             let mut offsets = vec![0u32; tile_count + 1];
-            for item in chunk.iter().flatten() {
-                for t in tiles_of(&item.rect) {
+            for (rect, _) in chunk.iter().flatten() {
+                for t in tiles_of(rect) {
                     offsets[t + 1] += 1;
                 }
             }
@@ -74,8 +87,8 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
             let mut fill = offsets.clone();
             let mut members = vec![0u32; offsets[tile_count] as usize];
             for (k, item) in chunk.iter().enumerate() {
-                let Some(item) = item else { continue };
-                for t in tiles_of(&item.rect) {
+                let Some((rect, _)) = item else { continue };
+                for t in tiles_of(rect) {
                     members[fill[t] as usize] = base + k as u32;
                     fill[t] += 1;
                 }
@@ -83,7 +96,6 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
             Binned { offsets, members }
         })
         .collect();
-    let placed = items.iter().flatten().count() as u64;
 
     // 2. Tiles in parallel, in input order within a tile, each resolved by
     // its worker (the samples never outlive their tile).
@@ -100,13 +112,15 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
                     let mut counters = RasterCounters::default();
                     let members = runs.iter().flat_map(|run| run.of(t));
                     for &k in members {
-                        // Only placed slots were sorted into tiles.
-                        let Some(item) = &items[k as usize] else {
+                        // Only items with a box (and so a triangle) were sorted into tiles.
+                        let k = k as usize;
+                        let (Some((rect, id)), Some(tri)) = (items.boxes[k], &items.triangles[k])
+                        else {
                             continue;
                         };
                         // Non-empty: the item was sorted into this tile by its rect.
-                        if let Some(clip) = item.rect.intersect(tile.rect()) {
-                            raster_triangle(tile, &item.tri, item.id, clip, oracles, &mut counters);
+                        if let Some(clip) = rect.intersect(tile.rect()) {
+                            raster_triangle(tile, tri, id, clip, oracles, &mut counters);
                         }
                     }
                     counters
@@ -115,5 +129,5 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
         )
         .collect();
     pass.add(done);
-    (pass, placed)
+    pass
 }
