@@ -112,7 +112,7 @@ impl FragmentLayers {
 /// first stored sample (depth, triangle id), its counters summed over its
 /// samples and, with anti-aliasing, its sample digest; returns the tile's
 /// coverage histogram. Colours are [`shade_tile`]'s.
-pub(crate) fn resolve_tile(tile: &TileBuffer, out: &mut TilePlanes) -> CoverageHistogram {
+fn resolve_tile(tile: &TileBuffer, out: &mut TilePlanes) -> CoverageHistogram {
     let pattern = tile.pattern;
     let (stored, pixels) = (pattern.stored, tile.pixels);
     let width = (tile.x1 - tile.x0) as usize;
@@ -150,10 +150,29 @@ pub(crate) fn resolve_tile(tile: &TileBuffer, out: &mut TilePlanes) -> CoverageH
     CoverageHistogram::of(&tile.coverage_writes)
 }
 
+/// A rendered tile into the frame: [`resolve_tile`], then [`shade_tile`];
+/// with the seconds each took (the resolve and shading stages).
+pub(crate) fn finish_tile(
+    tile: &TileBuffer,
+    view: &View,
+    shader: &Shader,
+    out: &mut TilePlanes,
+) -> (TileTotals, [f64; 2]) {
+    let start = Instant::now();
+    let histogram = resolve_tile(tile, out);
+    let resolved = Instant::now();
+    let totals = TileTotals {
+        histogram,
+        ..shade_tile(tile, view, shader, out)
+    };
+    let seconds = [resolved - start, resolved.elapsed()].map(|d| d.as_secs_f64());
+    (totals, seconds)
+}
+
 /// The colour of every pixel of `tile`, written into `out` (and, with
 /// transparency, the fragments blended there): the shading of its samples
 /// and the box filter over them. Returns what the shading counted.
-pub(crate) fn shade_tile(
+fn shade_tile(
     tile: &TileBuffer,
     view: &View,
     shader: &Shader,
@@ -308,10 +327,28 @@ fn shade_single_on<L: Lanes>(
 ) {
     let [ox, oy] = tile.pattern.positions[0];
     let width = (tile.x1 - tile.x0) as usize;
+    let rows = (tile.y1 - tile.y0) as usize;
     for (r, y) in (tile.y0..tile.y1).enumerate() {
         let ids = &tile.triangle_id[r * width..][..width];
         let depths = &tile.depth[r * width..][..width];
         let colors = &mut *out.color[r];
+        // Two rows ahead the records, one row ahead what they point at.
+        let ahead =
+            |k: usize| (r + k < rows).then(|| &tile.triangle_id[(r + k) * width..][..width]);
+        for &id in ahead(2)
+            .into_iter()
+            .flatten()
+            .filter(|&&id| id != BACKGROUND)
+        {
+            shader.prefetch_records(id);
+        }
+        for &id in ahead(1)
+            .into_iter()
+            .flatten()
+            .filter(|&&id| id != BACKGROUND)
+        {
+            shader.prefetch_pointed(id);
+        }
         for c0 in (0..width).step_by(8) {
             let n = (width - c0).min(8);
             let mut eight = EightSamples {

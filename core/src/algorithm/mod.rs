@@ -30,7 +30,7 @@ use crate::ground::{FieldError, PixelRect};
 use crate::pipeline::{EdgeKind, Pipeline, SampleOracles, TraversalOracles};
 use crate::precision::Precision;
 use crate::prepared::PreparedScene;
-use crate::resolve::{resolve_tile, shade_tile};
+use crate::resolve::finish_tile;
 use crate::screen_boxes::ScreenBoxes;
 use crate::shade::Shader;
 use crate::stats::{CoverageHistogram, RasterCounters, Stats};
@@ -276,20 +276,13 @@ impl<'a> TileContext<'a> {
         let precise = crate::edge::precise_tests();
         let result = render(tile);
         let precise_after = crate::edge::precise_tests();
-        let rendered = Instant::now();
-        let histogram = resolve_tile(tile, &mut planes);
-        let resolved = Instant::now();
-        let totals = TileTotals {
-            histogram,
-            ..shade_tile(tile, self.view, &self.shader, &mut planes)
-        };
-        let shaded = Instant::now();
+        let rendered = start.elapsed().as_secs_f64();
+        let (totals, [resolved, shaded]) = finish_tile(tile, self.view, &self.shader, &mut planes);
         Finished {
             totals,
             result,
             precise: [0, 1].map(|k| precise_after[k] - precise[k]),
-            seconds: [rendered - start, resolved - rendered, shaded - resolved]
-                .map(|d| d.as_secs_f64()),
+            seconds: [rendered, resolved, shaded],
         }
     }
 }

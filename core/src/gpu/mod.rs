@@ -22,7 +22,7 @@ use crate::camera::View;
 use crate::framebuffer::{Framebuffer, TileBuffer};
 use crate::ground::PixelRect;
 use crate::prepared::PreparedScene;
-use crate::resolve::{resolve_tile, shade_tile};
+use crate::resolve::finish_tile;
 use crate::shade::Shader;
 use crate::stats::Stats;
 
@@ -522,22 +522,22 @@ pub(crate) fn render_gpu_raster(
     let far = orthographic_far(scene, view);
     let samples = gpu.draw(mesh, view, far)?;
     stats.time_ms.coverage = start.elapsed().as_secs_f64() * 1e3;
-    // 3. Resolve and shade on the CPU, as every algorithm does.
+    // 3. Resolve and shade on the CPU, as every algorithm does: the read-back
+    // is one tile of the whole frame.
     let start = Instant::now();
     let pattern = crate::AaMode::None.pattern();
-    let mut tile = TileBuffer::new(PixelRect::new(0, 0, view.width, view.height), &pattern, &[]);
+    let whole = PixelRect::new(0, 0, view.width, view.height);
+    let mut tile = TileBuffer::new(whole, &pattern, &[]);
     tile.triangle_id = samples.triangle_id;
     tile.depth = samples.depth;
     tile.coverage_writes = samples.fragments.into_iter().map(u32::from).collect();
-    let whole = [PixelRect::new(0, 0, view.width, view.height)];
-    let [mut planes] = <[_; 1]>::try_from(fb.tile_planes(&whole)).expect("one tile");
-    stats.coverage_histogram = resolve_tile(&tile, &mut planes);
-    stats.time_ms.resolve = start.elapsed().as_secs_f64() * 1e3;
-    let start = Instant::now();
-    let totals = shade_tile(&tile, view, shader, &mut planes);
+    let mut planes = fb.tile_planes(&[whole]).pop().expect("one tile");
+    stats.time_ms.store += start.elapsed().as_secs_f64() * 1e3;
+    let (totals, [resolve, shading]) = finish_tile(&tile, view, shader, &mut planes);
+    stats.coverage_histogram = totals.histogram;
     stats.effects = totals.effects.report(shader.plan(), &scene.scene);
     stats.shading_samples = totals.shading_samples;
-    stats.time_ms.shading = start.elapsed().as_secs_f64() * 1e3;
+    (stats.time_ms.resolve, stats.time_ms.shading) = (resolve * 1e3, shading * 1e3);
     Ok(())
 }
 
