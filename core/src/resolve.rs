@@ -172,12 +172,7 @@ pub(crate) fn finish_tile(
 /// The colour of every pixel of `tile`, written into `out` (and, with
 /// transparency, the fragments blended there): the shading of its samples
 /// and the box filter over them. Returns what the shading counted.
-fn shade_tile(
-    tile: &TileBuffer,
-    view: &View,
-    shader: &Shader,
-    out: &mut TilePlanes,
-) -> TileTotals {
+fn shade_tile(tile: &TileBuffer, view: &View, shader: &Shader, out: &mut TilePlanes) -> TileTotals {
     let pattern = tile.pattern;
     let (stored, pixels) = (pattern.stored, tile.pixels);
     debug_assert!(stored <= MAX_STORED);
@@ -327,27 +322,22 @@ fn shade_single_on<L: Lanes>(
 ) {
     let [ox, oy] = tile.pattern.positions[0];
     let width = (tile.x1 - tile.x0) as usize;
-    let rows = (tile.y1 - tile.y0) as usize;
     for (r, y) in (tile.y0..tile.y1).enumerate() {
         let ids = &tile.triangle_id[r * width..][..width];
         let depths = &tile.depth[r * width..][..width];
         let colors = &mut *out.color[r];
         // Two rows ahead the records, one row ahead what they point at.
-        let ahead =
-            |k: usize| (r + k < rows).then(|| &tile.triangle_id[(r + k) * width..][..width]);
-        for &id in ahead(2)
-            .into_iter()
-            .flatten()
-            .filter(|&&id| id != BACKGROUND)
-        {
-            shader.prefetch_records(id);
+        let row =
+            |k: usize| (tile.triangle_id.get((r + k) * width..(r + k + 1) * width)).unwrap_or(&[]);
+        for &id in row(2) {
+            if id != BACKGROUND {
+                shader.prefetch_records(id);
+            }
         }
-        for &id in ahead(1)
-            .into_iter()
-            .flatten()
-            .filter(|&&id| id != BACKGROUND)
-        {
-            shader.prefetch_pointed(id);
+        for &id in row(1) {
+            if id != BACKGROUND {
+                shader.prefetch_pointed(id);
+            }
         }
         for c0 in (0..width).step_by(8) {
             let n = (width - c0).min(8);
