@@ -326,19 +326,6 @@ fn shade_single_on<L: Lanes>(
         let ids = &tile.triangle_id[r * width..][..width];
         let depths = &tile.depth[r * width..][..width];
         let colors = &mut *out.color[r];
-        // Two rows ahead the records, one row ahead what they point at.
-        let row =
-            |k: usize| (tile.triangle_id.get((r + k) * width..(r + k + 1) * width)).unwrap_or(&[]);
-        for &id in row(2) {
-            if id != BACKGROUND {
-                shader.prefetch_records(id);
-            }
-        }
-        for &id in row(1) {
-            if id != BACKGROUND {
-                shader.prefetch_pointed(id);
-            }
-        }
         for c0 in (0..width).step_by(8) {
             let n = (width - c0).min(8);
             let mut eight = EightSamples {

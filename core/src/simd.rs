@@ -287,21 +287,3 @@ macro_rules! dispatch {
     };
 }
 pub(crate) use dispatch;
-
-/// Asks the CPU to bring the cache line holding `value` closer (a hint:
-/// nothing is read, nothing can fault; a no-op off x86-64). For loops that
-/// know which scattered records they will read a little later — the shading
-/// of tiny triangles reads a few per pixel from arrays of millions.
-#[inline(always)]
-pub(crate) fn prefetch<T>(value: &T) {
-    // SAFETY: a prefetch is a hint that reads no memory and cannot fault,
-    // whatever the address; SSE, which it needs, is part of every x86-64.
-    #[cfg(target_arch = "x86_64")]
-    unsafe {
-        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
-            std::ptr::from_ref(value).cast::<i8>(),
-        );
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = value;
-}

@@ -147,18 +147,8 @@ fn screen_vertex(view: &View, c: DVec3) -> ScreenVertex {
     }
 }
 
-/// How far any setup's vertices may lie from the projected ones: fixed
-/// point snaps them by at most 1/512 pixel (f32 keeps them); a quarter of
-/// this would do.
-const SNAP_PAD: f32 = 1.0 / 128.0;
-
 /// One projected piece of triangle `id` set up by `make`, with its pixels;
 /// `None` when it has no samples on screen.
-///
-/// A piece whose vertices' box, padded by [`SNAP_PAD`], holds no sample is
-/// dropped before its setup (on scenes of tiny triangles, a third of them):
-/// that box holds the set-up triangle's, so the setup would have found no
-/// pixels either.
 #[inline]
 fn piece<T>(
     view: &View,
@@ -167,16 +157,6 @@ fn piece<T>(
     vertices: &[ScreenVertex; 3],
     id: u32,
 ) -> Option<Piece<T>> {
-    let [a, b, c] = vertices;
-    PixelRect::from_bounds(
-        a.x.min(b.x).min(c.x) - SNAP_PAD,
-        a.y.min(b.y).min(c.y) - SNAP_PAD,
-        a.x.max(b.x).max(c.x) + SNAP_PAD,
-        a.y.max(b.y).max(c.y) + SNAP_PAD,
-        view.width,
-        view.height,
-        span,
-    )?;
     let (tri, [x0, y0, x1, y1]) = make(vertices)?;
     let rect = PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height, span)?;
     Some(Piece { tri, rect, id })

@@ -15,7 +15,7 @@
 use glam::Vec3;
 
 use super::{AMBIENT, LightFrom, Shader};
-use crate::simd::{self, Lanes};
+use crate::simd::Lanes;
 
 /// Three lanes of f32: eight vectors.
 #[derive(Clone, Copy)]
@@ -134,38 +134,6 @@ impl Shader<'_> {
     pub(crate) fn shades_in_lanes(&self, id: u32) -> bool {
         let material = self.scene.scene.mesh.material_ids[id as usize];
         self.lane_materials.get(material as usize) == Some(&true)
-    }
-
-    /// Prefetches what [`Shader::shade_eight`] reads by triangle `id` itself:
-    /// its material, BVH slot, face normal and vertex indices. The first of
-    /// two stages, for samples a couple of rows ahead: tiny triangles make
-    /// every shaded pixel a different triangle, each record a cache miss.
-    #[inline(always)]
-    pub(crate) fn prefetch_records(&self, id: u32) {
-        let (prepared, id) = (self.scene, id as usize);
-        let mesh = &prepared.scene.mesh;
-        simd::prefetch(&mesh.material_ids[id]);
-        simd::prefetch(&prepared.slot_of[id]);
-        simd::prefetch(&prepared.face_normals[id]);
-        if !mesh.normals.is_empty() {
-            simd::prefetch(&mesh.triangles[id]);
-        }
-    }
-
-    /// The second stage of [`Shader::prefetch_records`], a row later: what
-    /// those records point at (the triangle's corners, its vertex normals).
-    #[inline(always)]
-    pub(crate) fn prefetch_pointed(&self, id: u32) {
-        let (prepared, id) = (self.scene, id as usize);
-        let mesh = &prepared.scene.mesh;
-        if let Some(corners) = prepared.slot_corners.get(prepared.slot_of[id] as usize) {
-            simd::prefetch(corners);
-        }
-        if !mesh.normals.is_empty() {
-            for &v in &mesh.triangles[id] {
-                simd::prefetch(&mesh.normals[v as usize]);
-            }
-        }
     }
 
     /// The linear colour [`Shader::shade`] gives each lane of `s`, and the
