@@ -159,27 +159,24 @@ fn sample_small<L: Lanes, T: Coverage>(
     r: PixelRect,
 ) -> u32 {
     let pattern = tile.pattern;
-    let count = pattern.positions.len();
-    let shift = count.trailing_zeros();
-    let width = r.width() as usize;
-    let total = (width * r.height() as usize) << shift;
+    let count = pattern.positions.len() as u32;
     let (mut xs, mut ys, mut at) = ([0.0; 8], [0.0; 8], [0usize; 8]);
-    for l in 0..8 {
-        // Spare lanes repeat the last sample; their bits are dropped.
-        let s = l.min(total - 1);
-        let (p, c) = (s >> shift, s & (count - 1));
-        let (x, y) = (r.x0 + (p % width) as u32, r.y0 + (p / width) as u32);
-        let [ox, oy] = pattern.positions[c];
-        (xs[l], ys[l]) = (x as f32 + ox, y as f32 + oy);
-        at[l] = c * tile.pixels + tile.index(x, y);
-    }
+    let mut n = 0;
     for y in r.y0..r.y1 {
         let i = tile.index(r.x0, y);
-        for evals in &mut tile.edge_evals[i..i + width] {
-            *evals += count as u32;
+        for (k, x) in (r.x0..r.x1).enumerate() {
+            tile.edge_evals[i + k] += count;
+            for (c, [ox, oy]) in pattern.positions.iter().enumerate() {
+                (xs[n], ys[n], at[n]) = (x as f32 + ox, y as f32 + oy, c * tile.pixels + i + k);
+                n += 1;
+            }
         }
     }
-    let (mask, w) = tri.sample_points8::<L>(xs, ys, first_lanes(total));
+    // Spare lanes repeat the last sample; their bits are dropped.
+    for l in n..8 {
+        (xs[l], ys[l], at[l]) = (xs[n - 1], ys[n - 1], at[n - 1]);
+    }
+    let (mask, w) = tri.sample_points8::<L>(xs, ys, first_lanes(n));
     let mut covered = mask;
     while covered != 0 {
         let l = covered.trailing_zeros() as usize;
