@@ -99,7 +99,7 @@ fn early_z_rejects<T: Coverage>(
 simd::dispatch! {
     /// Tests every sample of `r` (per-sample coverage, the leaf of every strategy);
     /// returns how many coverage samples the triangle covers.
-    fn test_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRect) -> u32
+    pub(crate) fn test_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRect) -> u32
         => test_samples_on
 }
 
@@ -189,7 +189,7 @@ fn sample_small<L: Lanes, T: Coverage>(
 simd::dispatch! {
     /// Writes every sample of `r`, known to be inside the edges: only depth is
     /// computed (with its `near` test). Returns the number of samples written.
-    fn fill_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRect) -> u32
+    pub(crate) fn fill_samples<T: Coverage>(tile: &mut TileBuffer, tri: &T, id: u32, r: PixelRect) -> u32
         => fill_samples_on
 }
 

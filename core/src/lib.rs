@@ -54,6 +54,7 @@ mod screen_boxes;
 // Floor 7 — the stages: shading, binning, traversal, the anti-aliasing resolve.
 mod shade;
 mod binning;
+mod scanline;
 mod traversal;
 mod resolve;
 // Floor 8 — the algorithms (the GPU's among them) and their one dispatch.

@@ -106,6 +106,9 @@ impl fmt::Display for Oracles {
 pub struct SampleOracles {
     /// Hierarchical tile tests instead of testing every sample of the box.
     pub binning: bool,
+    /// Spans instead of the box: each row's run of covered pixels found by
+    /// walking the straight edges (`2dr-scanline`; the others off).
+    pub spans: bool,
     /// Blocks of this many pixels square (a power of two) are tested sample by sample.
     pub leaf: u32,
     /// Skip blocks that the hierarchical w-buffer shows are hidden.
@@ -118,12 +121,14 @@ pub struct SampleOracles {
 impl SampleOracles {
     pub const BRUTE: SampleOracles = SampleOracles {
         binning: false,
+        spans: false,
         leaf: 8,
         early_z: false,
         incremental: false,
     };
     pub const BINNED: SampleOracles = SampleOracles {
         binning: true,
+        spans: false,
         leaf: 8,
         early_z: true,
         incremental: false,
@@ -194,6 +199,13 @@ impl AlgorithmId {
                 edges: EdgeKind::TwoD,
                 samples: SampleOracles::BINNED,
             },
+            AlgorithmId::TwoDScanline => Pipeline::AllTriangles {
+                edges: EdgeKind::TwoD,
+                samples: SampleOracles {
+                    spans: true,
+                    ..SampleOracles::BRUTE
+                },
+            },
             AlgorithmId::TwoDHomogeneous => Pipeline::AllTriangles {
                 edges: EdgeKind::Homogeneous,
                 samples: SampleOracles::BRUTE,
@@ -225,6 +237,9 @@ impl Pipeline {
         let bad = |m: &str| FieldError::new("oracles", m);
         let mut p = self;
         let samples = match &mut p {
+            Pipeline::AllTriangles { samples, .. } if samples.spans => {
+                return Err(bad("2dr-scanline walks spans and takes no oracles"));
+            }
             Pipeline::AllTriangles { samples, .. } => samples,
             Pipeline::Frusta(t) => &mut t.samples,
             Pipeline::Rays => return Err(bad("raycast takes no oracles")),

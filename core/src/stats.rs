@@ -130,6 +130,12 @@ pub struct RasterCounters {
     pub nodes_culled_outside: u64,
     /// BVH nodes culled because the hierarchical w-buffer hides them.
     pub nodes_culled_occluded: u64,
+    /// Runs of pixels (one per pixel row a triangle reaches) that the span
+    /// traversal (`2dr-scanline`) found covered.
+    pub spans: u64,
+    /// Single-edge decisions the span traversal made to find where its spans
+    /// start and end (the corrections to each edge's walked crossing).
+    pub edge_steps: u64,
     /// 3D (and homogeneous) edge tests within the f32 rounding bound of
     /// zero, decided again in f64 (README: "Precision and exactness").
     pub edge_tests_f64: u64,
@@ -149,6 +155,8 @@ impl std::ops::AddAssign for RasterCounters {
         self.frusta_split += o.frusta_split;
         self.nodes_culled_outside += o.nodes_culled_outside;
         self.nodes_culled_occluded += o.nodes_culled_occluded;
+        self.spans += o.spans;
+        self.edge_steps += o.edge_steps;
         self.edge_tests_f64 += o.edge_tests_f64;
         self.edge_tests_exact += o.edge_tests_exact;
     }

@@ -23,14 +23,16 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::aa::SamplePattern;
+use crate::binning::raster_triangle;
 use crate::camera::View;
 use crate::edge::{CurvedTriangle, Triangle3D, Triangle3D64};
 use crate::framebuffer::{Framebuffer, TileBuffer, TilePlanes, TileTotals};
 use crate::ground::{FieldError, PixelRect};
-use crate::pipeline::{EdgeKind, Pipeline, SampleOracles, TraversalOracles};
+use crate::pipeline::{EdgeKind, Pipeline, TraversalOracles};
 use crate::precision::Precision;
 use crate::prepared::PreparedScene;
 use crate::resolve::finish_tile;
+use crate::scanline::raster_spans;
 use crate::screen_boxes::ScreenBoxes;
 use crate::shade::Shader;
 use crate::stats::{CoverageHistogram, RasterCounters, Stats};
@@ -55,15 +57,32 @@ pub(crate) fn run(
         Pipeline::AllTriangles { edges, samples } => {
             let start = Instant::now();
             let span = pattern.span;
-            // One generic call per edge kind (a closure cannot be generic).
+            // One generic call per edge kind (a closure cannot be generic),
+            // each triangle rasterized by the box or hierarchy of `binning`,
+            // or (`spans`, straight edges) by the sweep line of `scanline`.
             macro_rules! tiles {
                 ($items:expr) => {
-                    timed_tiles(&$items, fb, samples, context, stats, start)
+                    timed_tiles(
+                        &$items,
+                        fb,
+                        context,
+                        stats,
+                        start,
+                        |tile, tri, id, clip, n| raster_triangle(tile, tri, id, clip, samples, n),
+                    )
+                };
+                ($items:expr, spans) => {
+                    timed_tiles(&$items, fb, context, stats, start, raster_spans)
                 };
             }
+            let fixed = precision == Precision::Fixed;
             match edges {
-                EdgeKind::TwoD if precision == Precision::Fixed => {
-                    tiles!(setup2d::setup_2d_fixed(scene, view, span))
+                EdgeKind::TwoD if fixed && samples.spans => {
+                    tiles!(setup2d::setup_2d_fixed(scene, view, span), spans)
+                }
+                EdgeKind::TwoD if fixed => tiles!(setup2d::setup_2d_fixed(scene, view, span)),
+                EdgeKind::TwoD if samples.spans => {
+                    tiles!(setup2d::setup_2d(scene, view, span), spans)
                 }
                 EdgeKind::TwoD => tiles!(setup2d::setup_2d(scene, view, span)),
                 EdgeKind::Homogeneous => {
@@ -190,17 +209,17 @@ fn render_frusta<'a, T: crate::edge::Coverage>(
     pass
 }
 
-fn timed_tiles<T: crate::edge::Coverage + Sync>(
+fn timed_tiles<T: Sync>(
     items: &tiles::Setups<T>,
     fb: &mut Framebuffer,
-    samples: SampleOracles,
     context: &TileContext,
     stats: &mut Stats,
     start: Instant,
+    kernel: impl Fn(&mut TileBuffer, &T, u32, PixelRect, &mut RasterCounters) + Sync,
 ) -> Pass {
     stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
     let start = Instant::now();
-    let pass = rasterize_tiled(items, fb, samples, context);
+    let pass = rasterize_tiled(items, fb, context, kernel);
     stats.triangle_setups = items.placed();
     let [coverage, resolve, shading] = pass.split(start);
     stats.time_ms.coverage = coverage;

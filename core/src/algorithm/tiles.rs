@@ -5,10 +5,7 @@
 use rayon::prelude::*;
 
 use super::{Pass, PixelRect, TileContext};
-use crate::binning::raster_triangle;
-use crate::edge::Coverage;
-use crate::framebuffer::Framebuffer;
-use crate::pipeline::SampleOracles;
+use crate::framebuffer::{Framebuffer, TileBuffer};
 use crate::stats::RasterCounters;
 
 /// Side of a screen tile in pixels.
@@ -51,12 +48,13 @@ impl<T> Setups<T> {
 }
 
 /// Renders `items` into `fb`, tile by tile in parallel (`None` items are
-/// triangles the setup dropped).
-pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
+/// triangles the setup dropped), each triangle within each tile by `kernel`
+/// (tile, triangle, id, the pixels of its box in the tile, counters).
+pub(crate) fn rasterize_tiled<T: Sync>(
     items: &Setups<T>,
     fb: &mut Framebuffer,
-    oracles: SampleOracles,
     context: &TileContext,
+    kernel: impl Fn(&mut TileBuffer, &T, u32, PixelRect, &mut RasterCounters) + Sync,
 ) -> Pass {
     let columns = fb.width.div_ceil(TILE) as usize;
     let rows = fb.height.div_ceil(TILE) as usize;
@@ -120,7 +118,7 @@ pub(crate) fn rasterize_tiled<T: Coverage + Sync>(
                         };
                         // Non-empty: the item was sorted into this tile by its rect.
                         if let Some(clip) = rect.intersect(tile.rect()) {
-                            raster_triangle(tile, tri, id, clip, oracles, &mut counters);
+                            kernel(tile, tri, id, clip, &mut counters);
                         }
                     }
                     counters

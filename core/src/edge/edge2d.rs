@@ -6,7 +6,10 @@
 //! apply opposite signs, so a sample on the edge goes to exactly one of them; a
 //! sample exactly on a vertex gets `E = 0` exactly on both of its edges.
 
-use super::{BlockTest, Coverage, LinearEdges, linear_classify, linear_sample, owns_tie};
+use super::{
+    BlockTest, Coverage, EdgeWalk, LinearEdges, inside_edge, linear_classify, linear_sample,
+    owns_tie,
+};
 use crate::simd::Lanes;
 
 /// A projected vertex: pixel coordinates and the depth quantity that is linear in
@@ -198,6 +201,20 @@ impl Coverage for Triangle2D {
 
     fn min_depth(&self) -> f32 {
         self.w_range[0]
+    }
+}
+
+impl EdgeWalk for Triangle2D {
+    /// `E = s·(Δx·(y − ly) − Δy·(x − lx))`: `a = −s·Δy`, `b = s·Δx`, both exact.
+    fn edge_line(&self, i: usize) -> [f64; 3] {
+        let ([lx, ly], [dx, dy], s) = (self.lo[i], self.delta[i], self.sign[i]);
+        let (a, b) = (f64::from(-dy * s), f64::from(dx * s));
+        [a, b, -a * f64::from(lx) - b * f64::from(ly)]
+    }
+
+    #[inline(always)]
+    fn inside_edge_at(&self, i: usize, x: f32, y: f32) -> bool {
+        inside_edge(self.raw(i, x, y) * self.sign[i], self.owns[i])
     }
 }
 

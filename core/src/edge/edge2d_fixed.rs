@@ -11,7 +11,7 @@
 //! snapped vertices are the even points of that grid.
 
 use super::edge2d::ScreenVertex;
-use super::{BlockTest, Coverage, owns_tie};
+use super::{BlockTest, Coverage, EdgeWalk, owns_tie};
 
 /// Fraction bits of snapped vertex positions (16.8 fixed point).
 pub const SUBPIXEL_BITS: u32 = 8;
@@ -121,11 +121,15 @@ impl Triangle2DFixed {
     /// The three exact edge values at a sample (sample-grid units).
     #[inline(always)]
     fn edge_values(&self, sx: i64, sy: i64) -> [i64; 3] {
-        std::array::from_fn(|i| {
-            let [x0, y0] = self.start[i];
-            let [dx, dy] = self.delta[i];
-            dx * (sy - y0) - dy * (sx - x0)
-        })
+        std::array::from_fn(|i| self.edge_value(i, sx, sy))
+    }
+
+    /// Edge `i`'s exact value at a sample (sample-grid units).
+    #[inline(always)]
+    fn edge_value(&self, i: usize, sx: i64, sy: i64) -> i64 {
+        let [x0, y0] = self.start[i];
+        let [dx, dy] = self.delta[i];
+        dx * (sy - y0) - dy * (sx - x0)
     }
 
     #[inline(always)]
@@ -143,6 +147,24 @@ impl Triangle2DFixed {
         let q = e[0] * self.q[0] + e[1] * self.q[1] + e[2] * self.q[2];
         let w = (if self.affine { q / sum } else { sum / q }) as f32;
         (w > 0.0 && w < f32::INFINITY).then(|| w.max(self.w_range[0]).min(self.w_range[1]))
+    }
+}
+
+impl EdgeWalk for Triangle2DFixed {
+    /// `E = Δx·(sy − y0) − Δy·(sx − x0)` on sample-grid units `s = 512·p`.
+    fn edge_line(&self, i: usize) -> [f64; 3] {
+        let ([x0, y0], [dx, dy]) = (self.start[i], self.delta[i]);
+        let (a, b) = (
+            (-dy) as f64 * f64::from(SAMPLE_ONE),
+            dx as f64 * f64::from(SAMPLE_ONE),
+        );
+        [a, b, (dy * x0 - dx * y0) as f64]
+    }
+
+    #[inline(always)]
+    fn inside_edge_at(&self, i: usize, x: f32, y: f32) -> bool {
+        let e = self.edge_value(i, sample_units(x), sample_units(y));
+        e > 0 || (e == 0 && self.owns[i])
     }
 }
 

@@ -195,6 +195,30 @@ fn lanes8(active: u8, sample: impl Fn(usize) -> Option<f32>) -> (u8, [f32; 8]) {
     (mask, depth)
 }
 
+/// Straight edges taken one at a time, for traversals that walk them from
+/// row to row (`2dr-scanline`: the lectures' sweep-line algorithm, the
+/// Princeton lecture's "Triangle Sweep-Line Algorithm").
+///
+/// Along a row of sample points `x + o` (integer `x`, a fixed offset `o`),
+/// [`EdgeWalk::inside_edge_at`] is monotone in `x`: every operation of an
+/// edge's evaluation (a difference, a product by a constant, a difference
+/// from a constant; or exact integers) is monotone in `x` and rounds
+/// monotonically, so the samples inside one edge are a prefix or a suffix of
+/// the row, and those inside all three a run. Where the run starts and ends
+/// can therefore be searched for with the edge's own decision, and is exact.
+pub trait EdgeWalk {
+    /// Edge `i` as the line `a·x + b·y + c = 0` in pixel coordinates, `a·x + b·y + c`
+    /// positive inside: the row's crossing `x = −(b·y + c)/a` starts the search
+    /// (it need not be exact), and the sign of `a` is exactly the direction in
+    /// which the edge's decision grows along a row (`0`: constant along rows).
+    fn edge_line(&self, i: usize) -> [f64; 3];
+
+    /// Edge `i`'s part of the coverage decision at the sample point `(x, y)`:
+    /// its value and the tie rule, bit for bit as [`Coverage::sample`] and
+    /// every lane form compute them.
+    fn inside_edge_at(&self, i: usize, x: f32, y: f32) -> bool;
+}
+
 /// Edge functions linear in the image point (planar viewports): the parts from
 /// which [`Coverage`] is assembled by [`linear_sample`] and [`linear_classify`].
 pub trait LinearEdges {

@@ -12,6 +12,8 @@ pub enum AlgorithmId {
     TwoDBrute,
     /// 2D edge functions with hierarchical tile tests and early-z.
     TwoDBin,
+    /// 2D edge functions, pixels enumerated span by span by walking the edges.
+    TwoDScanline,
     /// Olano–Greer homogeneous 2D rasterization, no clipping.
     TwoDHomogeneous,
     /// 3D edge functions over the bounding box, no projection.
@@ -49,9 +51,10 @@ pub enum Family {
 
 impl AlgorithmId {
     /// Every algorithm: the CPU ones and `gpu-raster`.
-    pub const ALL: [AlgorithmId; 10] = [
+    pub const ALL: [AlgorithmId; 11] = [
         AlgorithmId::TwoDBrute,
         AlgorithmId::TwoDBin,
+        AlgorithmId::TwoDScanline,
         AlgorithmId::TwoDHomogeneous,
         AlgorithmId::ThreeDBrute,
         AlgorithmId::ThreeDBin,
@@ -64,9 +67,10 @@ impl AlgorithmId {
 
     /// The algorithms continuum computes itself, on the CPU: within each family
     /// their results agree bit for bit.
-    pub const CPU: [AlgorithmId; 9] = [
+    pub const CPU: [AlgorithmId; 10] = [
         AlgorithmId::TwoDBrute,
         AlgorithmId::TwoDBin,
+        AlgorithmId::TwoDScanline,
         AlgorithmId::TwoDHomogeneous,
         AlgorithmId::ThreeDBrute,
         AlgorithmId::ThreeDBin,
@@ -80,6 +84,7 @@ impl AlgorithmId {
         match self {
             AlgorithmId::TwoDBrute => "2dr-brute",
             AlgorithmId::TwoDBin => "2dr-bin",
+            AlgorithmId::TwoDScanline => "2dr-scanline",
             AlgorithmId::TwoDHomogeneous => "2dr-homogeneous",
             AlgorithmId::ThreeDBrute => "3dr-brute",
             AlgorithmId::ThreeDBin => "3dr-bin",
@@ -93,7 +98,9 @@ impl AlgorithmId {
 
     pub fn family(self) -> Family {
         match self {
-            AlgorithmId::TwoDBrute | AlgorithmId::TwoDBin => Family::TwoD,
+            AlgorithmId::TwoDBrute | AlgorithmId::TwoDBin | AlgorithmId::TwoDScanline => {
+                Family::TwoD
+            }
             AlgorithmId::TwoDHomogeneous => Family::Homogeneous,
             AlgorithmId::GpuRaster => Family::Gpu,
             _ => Family::ThreeD,
@@ -108,6 +115,9 @@ impl AlgorithmId {
             }
             AlgorithmId::TwoDBin => {
                 "2D rasterization with hierarchical tile tests and early-z (hierarchical w-buffer)"
+            }
+            AlgorithmId::TwoDScanline => {
+                "2D rasterization by spans: each edge walked from row to row, the pixels between filled"
             }
             AlgorithmId::TwoDHomogeneous => "Olano-Greer homogeneous 2D rasterization, no clipping",
             AlgorithmId::ThreeDBrute => {
