@@ -32,6 +32,7 @@ mod color;
 mod precision;
 mod viewport;
 mod pipeline;
+pub mod draw;
 // Floor 2 — geometry and scenes.
 mod camera;
 pub mod scene;

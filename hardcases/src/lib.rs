@@ -343,6 +343,7 @@ fn counts_every_fragment(a: AlgorithmId) -> bool {
     matches!(
         a,
         AlgorithmId::TwoDBrute
+            | AlgorithmId::TwoDScanline
             | AlgorithmId::TwoDHomogeneous
             | AlgorithmId::ThreeDBrute
             | AlgorithmId::ThreeDFrustumCull
