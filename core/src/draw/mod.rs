@@ -6,8 +6,8 @@
 //!
 //! **Conventions**, as in the triangle rasterizers: image coordinates put
 //! pixel `(i, j)`'s centre at `(i + 0.5, j + 0.5)`; a pixel belongs to a shape
-//! when its centre does (or, anti-aliased, in the share of its
-//! [`SamplePattern`](crate::aa::SamplePattern) positions that do). The
+//! when its centre does (or, anti-aliased, in the share of its sample
+//! positions that do: [`sample_positions`], the triangles' for the same mode). The
 //! integer algorithms (Bresenham, the midpoint circle) take pixel indices:
 //! their points are those pixels' centres. Every primitive draws only inside
 //! its `[width, height]` and gives each pixel at most one
@@ -25,7 +25,15 @@ pub use line::{bresenham, dda};
 pub use polygon::{FillRule, fill_polygon};
 pub use stroke::{Cap, Join, Stroke, aa_line, stroke};
 
+use crate::aa::{AaMode, SamplePattern};
 use crate::ground::FieldError;
+
+/// The sample positions within a pixel (`[0, 1)²`) that the triangle
+/// rasterizers test under `aa` — every coverage position — for the
+/// anti-aliased primitives, so `--aa` means the same for both.
+pub fn sample_positions(aa: AaMode) -> Vec<[f32; 2]> {
+    SamplePattern::of(aa).positions
+}
 
 /// Where a primitive puts its pixels: pixel `(x, y)` inside the image, and
 /// the share of it the primitive covers, in `(0, 1]`.

@@ -6,12 +6,11 @@
 //!
 //! The stroke is the union of convex pieces — each segment's rectangle, the
 //! caps, the join wedges or discs — and each pixel is drawn once, with the
-//! share of its [`SamplePattern`] positions inside that union: the same
+//! share of its anti-aliasing positions ([`super::sample_positions`]) inside that union: the same
 //! positions the triangle rasterizers test for the same `--aa` mode, and no
 //! pixel covered twice where segments meet.
 
 use super::{Plot, finite};
-use crate::aa::SamplePattern;
 use crate::ground::FieldError;
 
 /// How a stroke ends.
@@ -211,14 +210,15 @@ fn pieces(points: &[[f64; 2]], style: &Stroke) -> Vec<Piece> {
 }
 
 /// Strokes the polyline `points` with `style`: each pixel of the image the
-/// stroke reaches once, with the share of `pattern`'s positions inside it.
+/// stroke reaches once, with the share of the sample `positions` (within
+/// a pixel, [`super::sample_positions`]) inside it.
 /// Fewer than two distinct points draw nothing; a width that is not a
 /// positive number is an error naming `width`, a point that is not finite
 /// one naming `stroke`.
 pub fn stroke(
     points: &[[f64; 2]],
     style: &Stroke,
-    pattern: &SamplePattern,
+    positions: &[[f32; 2]],
     size: [u32; 2],
     plot: &mut impl Plot,
 ) -> Result<(), FieldError> {
@@ -241,7 +241,10 @@ pub fn stroke(
         return Ok(());
     }
     let pieces = pieces(&distinct, style);
-    let share = 1.0 / pattern.positions.len() as f32;
+    if positions.is_empty() {
+        return Err(FieldError::new("aa", "no sample positions"));
+    }
+    let share = 1.0 / positions.len() as f32;
     let (width, height) = (f64::from(size[0]), f64::from(size[1]));
     // Rows the stroke reaches: the pieces' extents, within the image.
     let reach = distinct
@@ -271,8 +274,7 @@ pub fn stroke(
             let to = hi.floor().min(width - 1.0);
             let mut x = from;
             while x <= to {
-                let inside = pattern
-                    .positions
+                let inside = positions
                     .iter()
                     .filter(|[ox, oy]| {
                         let p = [x + f64::from(*ox), y0 + f64::from(*oy)];
@@ -292,23 +294,24 @@ pub fn stroke(
 }
 
 /// An anti-aliased line from `a` to `b`, `width` pixels wide, butt ends: a
-/// pixel's coverage is the share of `pattern`'s positions within the line's
+/// pixel's coverage is the share of the sample `positions` within the line's
 /// rectangle (so `--aa none` draws the pixels whose centres it holds).
 pub fn aa_line(
     a: [f64; 2],
     b: [f64; 2],
     width: f64,
-    pattern: &SamplePattern,
+    positions: &[[f32; 2]],
     size: [u32; 2],
     plot: &mut impl Plot,
 ) -> Result<(), FieldError> {
-    stroke(&[a, b], &Stroke::new(width), pattern, size, plot)
+    stroke(&[a, b], &Stroke::new(width), positions, size, plot)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::aa::AaMode;
+    use crate::draw::sample_positions;
     use std::collections::HashMap;
 
     const SIZE: [u32; 2] = [64, 48];
@@ -316,7 +319,7 @@ mod tests {
     fn coverage(
         points: &[[f64; 2]],
         style: &Stroke,
-        pattern: &SamplePattern,
+        pattern: &[[f32; 2]],
     ) -> HashMap<(u32, u32), f32> {
         let mut out = HashMap::new();
         stroke(points, style, pattern, SIZE, &mut |x, y, c| {
@@ -328,20 +331,17 @@ mod tests {
 
     /// Brute force over every pixel of the image: the share of positions
     /// for which `inside` holds.
-    fn brute(
-        pattern: &SamplePattern,
-        inside: impl Fn([f64; 2]) -> bool,
-    ) -> HashMap<(u32, u32), f32> {
+    fn brute(pattern: &[[f32; 2]], inside: impl Fn([f64; 2]) -> bool) -> HashMap<(u32, u32), f32> {
         let mut out = HashMap::new();
         for y in 0..SIZE[1] {
             for x in 0..SIZE[0] {
-                let n = (pattern.positions.iter())
+                let n = (pattern.iter())
                     .filter(|[ox, oy]| {
                         inside([f64::from(x) + f64::from(*ox), f64::from(y) + f64::from(*oy)])
                     })
                     .count();
                 if n > 0 {
-                    out.insert((x, y), n as f32 / pattern.positions.len() as f32);
+                    out.insert((x, y), n as f32 / pattern.len() as f32);
                 }
             }
         }
@@ -355,9 +355,9 @@ mod tests {
         (p[0] - q[0]).hypot(p[1] - q[1])
     }
 
-    fn patterns() -> Vec<SamplePattern> {
+    fn patterns() -> Vec<Vec<[f32; 2]>> {
         ["none", "msaa:4", "ssaa:16", "csaa:8x2"]
-            .map(|m| SamplePattern::of(AaMode::parse(m).unwrap()))
+            .map(|m| sample_positions(AaMode::parse(m).unwrap()))
             .to_vec()
     }
 
@@ -436,7 +436,7 @@ mod tests {
     #[test]
     fn joins_and_caps_nest() {
         let mut rng = fastrand::Rng::with_seed(33);
-        let pattern = SamplePattern::of(AaMode::parse("ssaa:16").unwrap());
+        let pattern = sample_positions(AaMode::parse("ssaa:16").unwrap());
         let mut strictly = [0; 2];
         for _ in 0..60 {
             let n = 3 + rng.usize(0..3);
@@ -475,7 +475,7 @@ mod tests {
 
     #[test]
     fn bad_and_degenerate_strokes() {
-        let pattern = SamplePattern::of(AaMode::None);
+        let pattern = sample_positions(AaMode::None);
         let mut n = 0;
         let mut plot = |_, _, _| n += 1;
         let e = stroke(
