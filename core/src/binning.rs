@@ -18,6 +18,7 @@ use crate::ground::PixelRect;
 use crate::pipeline::SampleOracles;
 use crate::simd::{self, Lanes, first_lanes};
 use crate::stats::RasterCounters;
+use crate::trace::BlockOutcome;
 
 /// Rasterizes `tri` (id `id`, screen box `rect`) into `tile`, limited to
 /// `clip` (pixels inside the tile).
@@ -366,7 +367,16 @@ fn bin_block<T: Coverage>(
     }
     // 4. The tile test.
     counters.tiles_tested += 1;
-    match test_block(tile, tri, r) {
+    let test = test_block(tile, tri, r);
+    tile.record(|t| {
+        let outcome = match test {
+            BlockTest::Outside => BlockOutcome::Rejected,
+            BlockTest::Inside => BlockOutcome::Accepted,
+            BlockTest::Partial => BlockOutcome::Refined,
+        };
+        t.blocks.push((r, outcome));
+    });
+    match test {
         BlockTest::Outside => {
             counters.tiles_rejected += 1;
             0

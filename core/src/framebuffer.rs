@@ -335,6 +335,8 @@ pub struct TileBuffer<'p> {
     pub opacity: &'p [f32],
     /// Covered samples of see-through triangles, in no particular order.
     pub fragments: Vec<Fragment>,
+    /// What the algorithm did in this tile, when the render records it.
+    pub trace: Option<crate::trace::Trace>,
     hiz_columns: u32,
     /// Has a stored depth decreased since the last [`TileBuffer::update_hiz`]?
     depth_lowered: bool,
@@ -386,8 +388,18 @@ impl<'p> TileBuffer<'p> {
             hiz: vec![f32::INFINITY; (hiz_columns * hiz_rows) as usize],
             opacity,
             fragments: Vec::new(),
+            trace: None,
             hiz_columns,
             depth_lowered: false,
+        }
+    }
+
+    /// Adds to the tile's trace, when the render records one (otherwise
+    /// one untaken branch).
+    #[inline(always)]
+    pub(crate) fn record(&mut self, add: impl FnOnce(&mut crate::trace::Trace)) {
+        if let Some(trace) = &mut self.trace {
+            add(trace);
         }
     }
 

@@ -48,6 +48,7 @@ mod bvh;
 mod prepared;
 // Floor 6 — frame buffers, statistics, images of them, screen boxes.
 mod stats;
+mod trace;
 mod framebuffer;
 pub mod maps;
 pub mod metrics;
@@ -67,6 +68,7 @@ mod algorithm;
 mod capability;
 mod words;
 mod render;
+mod overlay;
 pub mod internal;
 
 pub use aa::AaMode;
@@ -76,6 +78,7 @@ pub use color::{BACKGROUND_COLOR, decode_srgb};
 pub use effects::EffectStats;
 pub use framebuffer::{BACKGROUND, Framebuffer};
 pub use ground::{AlgorithmId, Bounds, Family, FieldError, MAX_DIMENSION, UnknownAlgorithm};
+pub use overlay::{LEGEND as OVERLAY_LEGEND, draw_overlays};
 pub use pipeline::Oracles;
 pub use precision::Precision;
 pub use prepared::PreparedScene;
@@ -85,6 +88,7 @@ pub use scene::{Scene, SceneError};
 pub use simd::{Isa, isa};
 pub use stats::{CoverageHistogram, Hashes, RasterCounters, StageTimes, Stats};
 pub use texture::TextureFilter;
+pub use trace::{BlockOutcome, FrustumEvent, NodeOutcome, Overlays, Trace};
 pub use viewport::Viewport;
 pub use words::{
     CameraSpec, DEFAULT_SIZE, ExplicitCamera, RenderWords, Settings, parse_algorithm, parse_size,

@@ -17,6 +17,7 @@ use crate::prepared::PreparedScene;
 use crate::request::RenderRequest;
 use crate::shade::Shader;
 use crate::stats::{Hashes, Stats};
+use crate::trace::Trace;
 
 /// Images and statistics of one render.
 #[derive(Clone, Debug)]
@@ -31,6 +32,8 @@ pub struct RenderOutput {
     pub framebuffer: Framebuffer,
     pub stats: Stats,
     pub hashes: Hashes,
+    /// What the algorithm did, when the request asked ([`RenderRequest::trace`]).
+    pub trace: Option<Trace>,
 }
 
 /// The summary document of a render (the `render --json` output).
@@ -94,6 +97,7 @@ pub fn render_cancellable(
         shader: Shader::new(scene, &view, request.texture_filter),
         opacity: &scene.triangle_opacity,
         cancel,
+        trace: request.trace,
     };
     // Every path resolves every pixel through `Framebuffer::tile_planes`.
     let start = Instant::now();
@@ -104,7 +108,7 @@ pub fn render_cancellable(
         context.shader.plan().transparency,
     );
     stats.time_ms.store = start.elapsed().as_secs_f64() * 1e3;
-    algorithm::run(
+    let trace = algorithm::run(
         pipeline,
         request.precision,
         scene,
@@ -149,5 +153,6 @@ pub fn render_cancellable(
         framebuffer: fb,
         stats,
         hashes,
+        trace,
     })
 }

@@ -25,6 +25,9 @@ pub struct RenderRequest {
     pub precision: Precision,
     /// How texture lookups are filtered (when the scene has textures).
     pub texture_filter: TextureFilter,
+    /// Record what the algorithm does ([`crate::Trace`]: tiles, binning's
+    /// blocks, frusta, BVH nodes) for overlays; off, nothing is recorded.
+    pub trace: bool,
 }
 
 impl RenderRequest {
@@ -40,6 +43,7 @@ impl RenderRequest {
             aa: AaMode::None,
             precision: Precision::F32,
             texture_filter: TextureFilter::default(),
+            trace: false,
         }
     }
 }

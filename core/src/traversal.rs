@@ -24,6 +24,7 @@ use crate::pipeline::TraversalOracles;
 use crate::prepared::PreparedScene;
 use crate::screen_boxes::ScreenBoxes;
 use crate::stats::RasterCounters;
+use crate::trace::{FrustumEvent, NodeOutcome};
 
 /// Sets up a leaf triangle's edge functions for a view (f32 or f64); the
 /// result may borrow both.
@@ -141,6 +142,8 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
         let root = self.node_box(bvh.total_aabb.min, bvh.total_aabb.max);
         let f = Frustum::new(self.tile.rect(), self.view);
         self.counters.frusta_created += 1;
+        self.tile
+            .record(|t| t.frusta.push((f.rect, FrustumEvent::Created)));
         self.traverse(&f, NodeRef::Inner(0), root);
     }
 
@@ -161,19 +164,28 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
         self.nodes_visited += 1;
         let f = frustum.rect;
         // 1. is_outside / is_occluded (Fig. 6a).
+        let node_box = |outcome| ([b.lo.to_array(), b.hi.to_array()], outcome);
         if self.oracles.outside && self.is_outside(frustum, &b) {
             self.counters.nodes_culled_outside += 1;
+            self.tile
+                .record(|t| t.nodes.push(node_box(NodeOutcome::Outside)));
             return;
         }
         if self.oracles.occluded && b.min_w > self.tile.hiz_max(f) {
             self.counters.nodes_culled_occluded += 1;
+            self.tile
+                .record(|t| t.nodes.push(node_box(NodeOutcome::Occluded)));
             return;
         }
+        self.tile
+            .record(|t| t.nodes.push(node_box(NodeOutcome::Entered)));
         // 2. split_frustum (Fig. 6b, c).
         if let Some(min) = self.oracles.split
             && self.should_split(frustum, &b, min)
         {
             self.counters.frusta_split += 1;
+            self.tile
+                .record(|t| t.frusta.push((f, FrustumEvent::Split)));
             // The first halves take the middle pixel of an odd side.
             let (mx, my) = ((f.x0 + f.x1).div_ceil(2), (f.y0 + f.y1).div_ceil(2));
             for q in [
@@ -184,6 +196,8 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
             ] {
                 if !q.is_empty() {
                     self.counters.frusta_created += 1;
+                    self.tile
+                        .record(|t| t.frusta.push((q, FrustumEvent::Created)));
                     self.traverse(&Frustum::new(q, self.view), node, b);
                 }
             }
@@ -265,6 +279,8 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
     /// Sets up the leaf's triangles and rasterizes them over the frustum.
     fn rasterize_leaf(&mut self, f: PixelRect, start: u32, count: u32) {
         let scene = self.scene;
+        self.tile
+            .record(|t| t.frusta.push((f, FrustumEvent::Rasterized)));
         for slot in start as usize..(start + count) as usize {
             // The slot-ordered copies: a leaf's triangles sit side by side.
             let (p, id) = (&scene.slot_corners[slot], scene.slot_triangles[slot]);

@@ -17,6 +17,7 @@ use crate::precision::Precision;
 use crate::request::RenderRequest;
 use crate::scene::Scene;
 use crate::texture::TextureFilter;
+use crate::trace::Overlays;
 use crate::viewport::Viewport;
 
 /// A render as a user says it, every value in the command line's words.
@@ -36,6 +37,8 @@ pub struct RenderWords {
     pub precision: Option<String>,
     pub texture_filter: Option<String>,
     pub size: Option<String>,
+    /// Overlays to draw over the images: `wireframe,tiles,frusta,bvh`.
+    pub overlays: Option<String>,
 }
 
 /// The words parsed: everything of a request but the scene's camera.
@@ -53,6 +56,9 @@ pub struct Settings {
     pub texture_filter: TextureFilter,
     pub width: u32,
     pub height: u32,
+    /// What to draw over the images (the request records a trace when an
+    /// overlay needs one).
+    pub overlays: Overlays,
 }
 
 /// The size `continuum render` and the service render at when none is given.
@@ -103,6 +109,10 @@ impl RenderWords {
                 .unwrap_or_default(),
             width,
             height,
+            overlays: word(&self.overlays)
+                .map(Overlays::parse)
+                .transpose()?
+                .unwrap_or_default(),
         })
     }
 
@@ -125,6 +135,7 @@ impl Settings {
             texture_filter: TextureFilter::default(),
             width,
             height,
+            overlays: Overlays::default(),
         }
     }
 
@@ -149,6 +160,7 @@ impl Settings {
             aa: self.aa,
             precision: self.precision,
             texture_filter: self.texture_filter,
+            trace: self.overlays.need_trace(),
         })
     }
 

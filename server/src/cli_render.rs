@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use continuum::{CameraSpec, PreparedScene, RenderWords, maps, render};
+use continuum::{CameraSpec, PreparedScene, RenderWords, draw_overlays, maps, render};
 
 use crate::{CliError, scenes_dir, write_stdout};
 
@@ -39,6 +39,10 @@ pub struct RenderArgs {
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "640x480")]
     size: String,
+    /// Draw what the algorithm did over every image written:
+    /// comma-separated wireframe, tiles, frusta, bvh.
+    #[arg(long)]
+    overlay: Option<String>,
     /// Write the colour image here (PNG).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -69,12 +73,21 @@ impl RenderArgs {
             precision: Some(self.precision.clone()),
             texture_filter: Some(self.texture_filter.clone()),
             size: Some(self.size.clone()),
+            overlays: self.overlay.clone(),
         }
     }
 }
 
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
-    let usage = |e: continuum::FieldError| CliError::Usage(format!("--{e}"));
+    let usage = |e: continuum::FieldError| {
+        // The words' field `overlays` is the flag `--overlay`.
+        let flag = if e.field == "overlays" {
+            "overlay"
+        } else {
+            e.field
+        };
+        CliError::Usage(format!("--{flag}: {}", e.message))
+    };
     // Every word checked before the scene is loaded.
     let settings = args.words().settings().map_err(usage)?;
     let scene =
@@ -95,8 +108,13 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         .install(|| render(&prepared, &request))
         .map_err(usage)?;
 
+    // Every image written gets the overlays asked for.
+    let finish = |mut img| {
+        draw_overlays(&mut img, settings.overlays, &out, &prepared);
+        maps::png_bytes(&img)
+    };
     if let Some(path) = &args.out {
-        std::fs::write(path, maps::png_bytes(&maps::color_image(&out.framebuffer)))
+        std::fs::write(path, finish(maps::color_image(&out.framebuffer)))
             .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(dir) = &args.maps {
@@ -108,7 +126,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             ("triangle_id.png", maps::triangle_id_image(fb)),
         ] {
             let path = dir.join(name);
-            std::fs::write(&path, maps::png_bytes(&img))
+            std::fs::write(&path, finish(img))
                 .with_context(|| format!("writing {}", path.display()))?;
         }
     }

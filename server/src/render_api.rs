@@ -10,8 +10,9 @@ use axum::http::header;
 use axum::response::{IntoResponse, Response};
 use base64::Engine;
 use continuum::{
-    AaMode, AlgorithmId, Bounds, Camera, CameraSpec, FieldError, Precision, RenderOutput,
-    RenderRequest, RenderWords, Settings, Viewport, maps,
+    AaMode, AlgorithmId, Bounds, Camera, CameraSpec, FieldError, Overlays, Precision,
+    PreparedScene, RenderOutput, RenderRequest, RenderWords, Settings, Viewport, draw_overlays,
+    maps,
 };
 use serde::Deserialize;
 use serde_json::{Value, json};
@@ -33,6 +34,25 @@ pub struct RenderBody {
     pub texture_filter: Option<String>,
     pub size: Option<String>,
     pub outputs: Option<Vec<String>>,
+    /// Overlays drawn over every image: `"frusta,tiles"` or `["frusta", "tiles"]`.
+    pub overlays: Option<OverlayWords>,
+}
+
+/// The overlays in words: one comma-separated string, or a list.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum OverlayWords {
+    Text(String),
+    List(Vec<String>),
+}
+
+impl OverlayWords {
+    fn text(&self) -> String {
+        match self {
+            OverlayWords::Text(t) => t.clone(),
+            OverlayWords::List(l) => l.join(","),
+        }
+    }
 }
 
 /// Image outputs a request may ask for.
@@ -51,6 +71,7 @@ impl RenderBody {
             precision: self.precision.clone(),
             texture_filter: self.texture_filter.clone(),
             size: self.size.clone(),
+            overlays: self.overlays.as_ref().map(OverlayWords::text),
         }
     }
 }
@@ -132,7 +153,7 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
 
 /// Renders on the blocking pool, at most `max_concurrent_renders` at once; up to
 /// `max_queued_renders` more wait for a slot, and beyond that the answer is 503.
-async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, String), ApiError> {
+async fn run(state: Arc<AppState>, c: Checked) -> Result<Rendered, ApiError> {
     let timeout = state.limits.render_timeout;
     let permit = match state.renders.clone().try_acquire_owned() {
         Ok(p) => p,
@@ -158,7 +179,13 @@ async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, 
         job_state
             .metrics
             .observe_render(request.algorithm.as_str(), out.stats.time_ms.total / 1e3);
-        Ok((out, prepared.scene.name.clone(), request.camera.name))
+        Ok(Rendered {
+            scene: prepared.scene.name.clone(),
+            camera: request.camera.name,
+            overlays: c.settings.overlays,
+            out,
+            prepared,
+        })
     });
     // The job keeps its render slot until it ends; a timed-out render is
     // cancelled, so it ends within a tile's time.
@@ -176,15 +203,28 @@ async fn run(state: Arc<AppState>, c: Checked) -> Result<(RenderOutput, String, 
     result.map_err(|e| ApiError::internal(format!("render failed: {e}")))?
 }
 
-fn image(out: &RenderOutput, name: &str) -> Vec<u8> {
-    let fb = &out.framebuffer;
-    let img = match name {
-        "edge_evals" => maps::edge_eval_image(fb),
-        "depth" => maps::depth_image(fb),
-        "triangle_id" => maps::triangle_id_image(fb),
-        _ => maps::color_image(fb),
-    };
-    maps::png_bytes(&img)
+/// A finished render, with what its images need.
+struct Rendered {
+    out: RenderOutput,
+    prepared: Arc<PreparedScene>,
+    scene: String,
+    camera: String,
+    overlays: Overlays,
+}
+
+impl Rendered {
+    /// The PNG of output `name`, with the overlays asked for drawn over it.
+    fn image(&self, name: &str) -> Vec<u8> {
+        let fb = &self.out.framebuffer;
+        let mut img = match name {
+            "edge_evals" => maps::edge_eval_image(fb),
+            "depth" => maps::depth_image(fb),
+            "triangle_id" => maps::triangle_id_image(fb),
+            _ => maps::color_image(fb),
+        };
+        draw_overlays(&mut img, self.overlays, &self.out, &self.prepared);
+        maps::png_bytes(&img)
+    }
 }
 
 /// `POST /api/render`.
@@ -197,20 +237,21 @@ pub async fn render_json(
     let body = body.map_err(|e| ApiError::body(&e))?;
     let body: RenderBody = serde_json::from_slice(&body).map_err(|e| json_error(&e))?;
     let checked = check(&body, &state)?;
-    let (out, scene, camera) = run(state, checked).await?;
-    let mut doc = serde_json::to_value(out.summary(&scene, &camera))
+    let rendered = run(state, checked).await?;
+    let out = &rendered.out;
+    let mut doc = serde_json::to_value(out.summary(&rendered.scene, &rendered.camera))
         .map_err(|e| ApiError::internal(e.to_string()))?;
     let outputs = body.outputs.unwrap_or_else(|| vec!["color".into()]);
     let images: serde_json::Map<String, Value> = outputs
         .iter()
         .map(|o| {
-            let png = base64::engine::general_purpose::STANDARD.encode(image(&out, o));
+            let png = base64::engine::general_purpose::STANDARD.encode(rendered.image(o));
             (o.clone(), Value::String(png))
         })
         .collect();
     doc["images"] = Value::Object(images);
     // The next render of this size reuses the frame's memory.
-    out.framebuffer.recycle();
+    rendered.out.framebuffer.recycle();
     Ok(Json(doc))
 }
 
@@ -228,6 +269,7 @@ pub struct RenderQuery {
     texture_filter: Option<String>,
     size: Option<String>,
     output: Option<String>,
+    overlays: Option<String>,
 }
 
 /// `GET /api/render.png`.
@@ -254,6 +296,7 @@ pub async fn render_png(
         texture_filter: q.texture_filter,
         size: q.size,
         outputs: Some(vec![output.clone()]),
+        overlays: q.overlays.map(OverlayWords::Text),
     };
     let checked = check(&body, &state).map_err(|mut e| {
         if e.field.as_deref() == Some("outputs") {
@@ -261,9 +304,9 @@ pub async fn render_png(
         }
         e
     })?;
-    let (out, _, _) = run(state, checked).await?;
-    let png = image(&out, &output);
-    out.framebuffer.recycle();
+    let rendered = run(state, checked).await?;
+    let png = rendered.image(&output);
+    rendered.out.framebuffer.recycle();
     Ok(([(header::CONTENT_TYPE, "image/png")], png).into_response())
 }
 
@@ -335,7 +378,17 @@ pub async fn algorithms() -> Result<Json<Value>, ApiError> {
             })
         })
         .collect();
-    Ok(Json(json!({ "algorithms": list })))
+    // The overlays any render may draw, and what their colours mean.
+    let legend: Vec<Value> = continuum::OVERLAY_LEGEND
+        .iter()
+        .map(|(meaning, [r, g, b, a])| {
+            json!({ "meaning": meaning, "color": format!("#{r:02x}{g:02x}{b:02x}{a:02x}") })
+        })
+        .collect();
+    Ok(Json(json!({
+        "algorithms": list,
+        "overlays": { "names": Overlays::NAMES, "legend": legend },
+    })))
 }
 
 /// A JSON body error → 400 naming the unknown or missing field, else `body`.

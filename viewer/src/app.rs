@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, PoisonError};
 
 use continuum::TextureFilter;
-use continuum::{AaMode, AlgorithmId, Precision, RenderOutput, Stats, Viewport};
+use continuum::{AaMode, AlgorithmId, Overlays, Precision, RenderOutput, Stats, Viewport};
 use eframe::egui::{self, Color32, ColorImage, TextureHandle, TextureOptions};
 
 use continuum::FieldError;
@@ -70,7 +70,13 @@ impl Shown {
         kind: ViewKind,
     ) -> Option<&(ColorImage, TextureHandle)> {
         if !self.images.contains_key(&(side, kind)) {
-            let image = kind.image(&self.output(side)?.framebuffer);
+            // The overlays the job asked for, drawn over every view of it.
+            let out = self.output(side)?;
+            let rendered = self.outcome.result.as_ref().ok()?;
+            let mut rgba = kind.rgba(&out.framebuffer);
+            let overlays = self.outcome.job.config.overlays;
+            continuum::draw_overlays(&mut rgba, overlays, out, &rendered.scene);
+            let image = images::to_color_image(&rgba);
             let texture = ctx.load_texture(
                 format!("{side:?}-{}", kind.label()),
                 image.clone(),
@@ -400,6 +406,7 @@ impl ViewerApp {
             ui.add(egui::DragValue::new(&mut self.config.threads).range(1..=64))
                 .labelled_by(label.id);
         });
+        overlay_controls(ui, &mut self.config.overlays);
 
         ui.add_space(6.0);
         let mut comparing = self.compare.is_some();
@@ -923,4 +930,31 @@ mod tests {
         let assets = scene_files(&dir.join("assets"));
         assert!(!assets.is_empty() && assets.iter().all(|f| has_scene_extension(f)));
     }
+}
+
+/// The overlays, one toggle each: what the algorithm did, drawn over the image.
+fn overlay_controls(ui: &mut egui::Ui, overlays: &mut Overlays) {
+    ui.horizontal_wrapped(|ui| {
+        ui.label("overlays");
+        for (flag, name, hint) in [
+            (&mut overlays.wireframe, "wireframe", "the triangles' edges"),
+            (
+                &mut overlays.tiles,
+                "tiles",
+                "the tile grid; blocks binning accepted (green), refined (yellow), rejected (red)",
+            ),
+            (
+                &mut overlays.frusta,
+                "frusta",
+                "frusta rasterized (green), split (orange), culled (red)",
+            ),
+            (
+                &mut overlays.bvh,
+                "bvh",
+                "the projected boxes of the BVH nodes the traversal entered",
+            ),
+        ] {
+            ui.checkbox(flag, name).on_hover_text(hint);
+        }
+    });
 }

@@ -6,8 +6,8 @@
 use std::path::{Path, PathBuf};
 
 use continuum::{
-    AaMode, AlgorithmId, Camera, CameraSpec, FieldError, Oracles, Precision, PreparedScene,
-    RenderRequest, RenderWords, Scene, Settings, TextureFilter,
+    AaMode, AlgorithmId, Camera, CameraSpec, FieldError, Oracles, Overlays, Precision,
+    PreparedScene, RenderRequest, RenderWords, Scene, Settings, TextureFilter,
 };
 
 /// Whether `path` names a scene file or a model the loaders read.
@@ -104,6 +104,8 @@ pub struct Config {
     pub height: u32,
     /// Worker threads for the render (rayon pool size).
     pub threads: usize,
+    /// What to draw over the images (the render records its trace when one needs it).
+    pub overlays: Overlays,
 }
 
 impl Default for Config {
@@ -116,6 +118,7 @@ impl Default for Config {
             width: 640,
             height: 480,
             threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            overlays: Overlays::default(),
         }
     }
 }
@@ -148,6 +151,7 @@ impl Config {
             },
             width: settings.width,
             height: settings.height,
+            overlays: settings.overlays,
             ..Config::default()
         })
     }
@@ -178,6 +182,7 @@ impl Config {
             aa: method.aa,
             precision: method.precision,
             texture_filter: method.texture_filter,
+            overlays: self.overlays,
             ..Settings::new(method.algorithm, self.width, self.height)
         })
     }

@@ -4,6 +4,7 @@
 
 use continuum::{BACKGROUND, Framebuffer, maps};
 use eframe::egui::{Color32, ColorImage};
+use image::RgbaImage;
 
 /// Which buffer the image view shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -54,13 +55,17 @@ impl ViewKind {
 
     /// This view of `fb`, by the core's own map functions.
     pub fn image(self, fb: &Framebuffer) -> ColorImage {
-        let rgba = match self {
+        to_color_image(&self.rgba(fb))
+    }
+
+    /// This view of `fb` as RGBA8, for overlays to draw on.
+    pub fn rgba(self, fb: &Framebuffer) -> RgbaImage {
+        match self {
             ViewKind::Color => maps::color_image(fb),
             ViewKind::EdgeEvals => maps::edge_eval_image(fb),
             ViewKind::Depth => maps::depth_image(fb),
             ViewKind::TriangleIds => maps::triangle_id_image(fb),
-        };
-        ColorImage::from_rgba_unmultiplied([fb.width as usize, fb.height as usize], rgba.as_raw())
+        }
     }
 }
 
@@ -144,6 +149,12 @@ pub fn difference(a: &Framebuffer, b: &Framebuffer) -> Option<Difference> {
         ids_differ,
         colours_differ,
     })
+}
+
+/// An RGBA8 image as egui's.
+pub fn to_color_image(rgba: &RgbaImage) -> ColorImage {
+    let (w, h) = rgba.dimensions();
+    ColorImage::from_rgba_unmultiplied([w as usize, h as usize], rgba.as_raw())
 }
 
 #[cfg(test)]

@@ -44,6 +44,10 @@ struct Args {
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "640x480")]
     size: String,
+    /// Draw what the algorithm did over the image: comma-separated
+    /// wireframe, tiles, frusta, bvh.
+    #[arg(long)]
+    overlay: Option<String>,
     /// Render threads (default: every core).
     #[arg(long)]
     threads: Option<usize>,
@@ -86,9 +90,11 @@ fn main() -> ExitCode {
         precision: Some(args.precision.clone()),
         texture_filter: Some(args.texture_filter.clone()),
         size: Some(args.size.clone()),
+        overlays: args.overlay.clone(),
     };
     let mut config = match Config::from_words(&words) {
         Ok(c) => c,
+        Err(e) if e.field == "overlays" => return usage(format!("--overlay: {}", e.message)),
         Err(e) => return usage(format!("--{e}")),
     };
     if let Some(t) = args.threads {

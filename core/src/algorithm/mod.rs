@@ -36,13 +36,15 @@ use crate::scanline::raster_spans;
 use crate::screen_boxes::ScreenBoxes;
 use crate::shade::Shader;
 use crate::stats::{CoverageHistogram, RasterCounters, Stats};
+use crate::trace::Trace;
 use crate::traversal::{Setup, Traversal};
 use tiles::rasterize_tiled;
 
 /// Renders `view` of `scene` with `pipeline` at `precision` into `fb`: the
 /// pixels, counters and stage times. The viewport must be one the pipeline
 /// [serves](Pipeline::serves), the precision one its family computes in
-/// (f64 on non-planar viewports is their f64 curved edges).
+/// (f64 on non-planar viewports is their f64 curved edges). Returns the
+/// tiles' trace when `context` records one.
 pub(crate) fn run(
     pipeline: Pipeline,
     precision: Precision,
@@ -50,7 +52,7 @@ pub(crate) fn run(
     context: &TileContext,
     fb: &mut Framebuffer,
     stats: &mut Stats,
-) -> Result<(), FieldError> {
+) -> Result<Option<Trace>, FieldError> {
     let (view, pattern) = (context.view, context.pattern);
     let f64 = precision == Precision::F64;
     let pass = match pipeline {
@@ -124,14 +126,14 @@ pub(crate) fn run(
         Pipeline::Rays => {
             raycast::render_raycast(scene, context, fb, stats, Triangle3D::setup_eight)
         }
-        Pipeline::Gpu => return render_gpu(scene, context, fb, stats),
+        Pipeline::Gpu => return render_gpu(scene, context, fb, stats).map(|()| None),
     };
     stats.time_ms.store += pass.store_ms;
     stats.counters = pass.counters;
     stats.coverage_histogram = pass.histogram;
     stats.shading_samples = pass.shading_samples;
     stats.effects = pass.effects.report(context.shader.plan(), &scene.scene);
-    Ok(())
+    Ok(pass.trace)
 }
 
 /// Why `gpu-raster` cannot run in a build without the `gpu` feature.
@@ -239,6 +241,8 @@ pub(crate) struct TileContext<'a> {
     /// Set by the caller to abandon the render: tiles not yet started are
     /// neither rendered nor resolved (checked once per tile or band).
     pub cancel: &'a std::sync::atomic::AtomicBool,
+    /// Record each tile's [`Trace`].
+    pub trace: bool,
 }
 
 /// A tile rendered and resolved by one worker, with what its rendering returned.
@@ -250,6 +254,8 @@ pub(crate) struct Finished<R> {
     pub precise: [u64; 2],
     /// Worker seconds spent rendering, resolving and shading.
     pub seconds: [f64; 3],
+    /// What rendering did, when the context records it.
+    pub trace: Option<Trace>,
 }
 
 impl<R> Finished<R> {
@@ -259,6 +265,7 @@ impl<R> Finished<R> {
             result: f(self.result),
             precise: self.precise,
             seconds: self.seconds,
+            trace: self.trace,
         }
     }
 }
@@ -282,6 +289,7 @@ impl<'a> TileContext<'a> {
                 result: R::default(),
                 precise: [0; 2],
                 seconds: [0.0; 3],
+                trace: None,
             };
         }
         let start = Instant::now();
@@ -292,8 +300,14 @@ impl<'a> TileContext<'a> {
             }
             None => cache.insert(TileBuffer::new(planes.rect, self.pattern, self.opacity)),
         };
+        if self.trace {
+            let mut trace = Trace::default();
+            trace.tiles.push(planes.rect);
+            tile.trace = Some(trace);
+        }
         let precise = crate::edge::precise_tests();
         let result = render(tile);
+        let trace = tile.trace.take();
         let precise_after = crate::edge::precise_tests();
         let rendered = start.elapsed().as_secs_f64();
         let (totals, [resolved, shaded]) = finish_tile(tile, self.view, &self.shader, &mut planes);
@@ -302,6 +316,7 @@ impl<'a> TileContext<'a> {
             result,
             precise: [0, 1].map(|k| precise_after[k] - precise[k]),
             seconds: [rendered, resolved, shaded],
+            trace,
         }
     }
 }
@@ -317,6 +332,8 @@ pub(crate) struct Pass {
     seconds: [f64; 3],
     /// Milliseconds spent cutting the frame into tiles.
     store_ms: f64,
+    /// The tiles' traces, when recorded.
+    pub trace: Option<Trace>,
 }
 
 impl Pass {
@@ -344,6 +361,9 @@ impl Pass {
             self.effects.add(&finished.totals.effects);
             for (sum, s) in self.seconds.iter_mut().zip(finished.seconds) {
                 *sum += s;
+            }
+            if let Some(trace) = finished.trace {
+                self.trace.get_or_insert_with(Trace::default).append(trace);
             }
         }
     }
