@@ -911,27 +911,6 @@ pub fn save_png(image: &ColorImage, path: &Path) -> Result<(), String> {
         .map_err(|e| format!("--screenshot: writing {}: {e}", path.display()))
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_scenes_folder_lists_its_scene_and_model_files() {
-        let dir = continuum::scene::default_scenes_dir();
-        let files = scene_files(&dir);
-        let names: Vec<String> = files
-            .iter()
-            .map(|f| SceneSource::Path(f.clone()).label())
-            .collect();
-        assert!(names.contains(&"bunny.toml".to_owned()), "{names:?}");
-        assert!(names.windows(2).all(|w| w[0] <= w[1]), "sorted: {names:?}");
-        assert!(files.iter().all(|f| has_scene_extension(f)));
-        // The assets folder holds models (glb) and their licences (not listed).
-        let assets = scene_files(&dir.join("assets"));
-        assert!(!assets.is_empty() && assets.iter().all(|f| has_scene_extension(f)));
-    }
-}
-
 /// The overlays, one toggle each: what the algorithm did, drawn over the image.
 fn overlay_controls(ui: &mut egui::Ui, overlays: &mut Overlays) {
     ui.horizontal_wrapped(|ui| {
@@ -957,4 +936,25 @@ fn overlay_controls(ui: &mut egui::Ui, overlays: &mut Overlays) {
             ui.checkbox(flag, name).on_hover_text(hint);
         }
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_scenes_folder_lists_its_scene_and_model_files() {
+        let dir = continuum::scene::default_scenes_dir();
+        let files = scene_files(&dir);
+        let names: Vec<String> = files
+            .iter()
+            .map(|f| SceneSource::Path(f.clone()).label())
+            .collect();
+        assert!(names.contains(&"bunny.toml".to_owned()), "{names:?}");
+        assert!(names.windows(2).all(|w| w[0] <= w[1]), "sorted: {names:?}");
+        assert!(files.iter().all(|f| has_scene_extension(f)));
+        // The assets folder holds models (glb) and their licences (not listed).
+        let assets = scene_files(&dir.join("assets"));
+        assert!(!assets.is_empty() && assets.iter().all(|f| has_scene_extension(f)));
+    }
 }
