@@ -170,12 +170,14 @@ impl SceneBvh {
     /// others ray by ray. `leaf(slot, cull)` is called for each primitive slot
     /// of every leaf the packet reaches and updates each lane's culling
     /// distance in `cull`. Returns the number of nodes whose children were
-    /// tested (once per node, for the packet). The slab tests run on lanes `L`
+    /// tested (once per node, for the packet), and adds their indices to
+    /// `entered` when given (a render's trace). The slab tests run on lanes `L`
     /// (the caller's instruction set, see [`crate::simd`]; inlined into it).
     #[inline(always)]
     pub fn walk_packet<L: Lanes>(
         &self,
         rays: PacketRays,
+        mut entered: Option<&mut Vec<u32>>,
         mut leaf: impl FnMut(u32, &mut [f32; PACKET]),
     ) -> u64 {
         if self.cwbvh.nodes.is_empty() {
@@ -227,7 +229,11 @@ impl SceneBvh {
             state,
             {
                 visited += 1;
-                let boxes = &self.child_boxes[node_index(bvh, node)];
+                let index = node_index(bvh, node);
+                if let Some(entered) = entered.as_deref_mut() {
+                    entered.push(index as u32);
+                }
+                let boxes = &self.child_boxes[index];
                 let hits = match &interval {
                     Some(interval) => interval.hits::<L>(boxes, tmax),
                     // A loop, not a closure: lane code must be inlined (see `crate::simd`).
@@ -252,6 +258,21 @@ impl SceneBvh {
             }
         );
         visited
+    }
+}
+
+impl SceneBvh {
+    /// Node `index`'s box: the union of its children's (padded) boxes.
+    pub fn node_box(&self, index: usize) -> [[f32; 3]; 2] {
+        let (node, boxes) = (&self.cwbvh.nodes[index], &self.child_boxes[index]);
+        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for child in (0..8).filter(|&c| !node.is_child_empty(c)) {
+            for a in 0..3 {
+                lo[a] = lo[a].min(boxes.lo[a][child]);
+                hi[a] = hi[a].max(boxes.hi[a][child]);
+            }
+        }
+        [lo, hi]
     }
 }
 

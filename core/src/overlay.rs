@@ -79,7 +79,7 @@ pub fn draw_overlays(
     let mut pen = Pen {
         painter: Painter { image, color: WIRE },
         size,
-        positions: draw::sample_positions(AaMode::parse("ssaa:16").expect("a mode")),
+        positions: draw::sample_positions(AaMode::Ssaa(16)),
     };
     if overlays.wireframe {
         pen.painter.color = WIRE;
@@ -90,33 +90,21 @@ pub fn draw_overlays(
         for &r in &trace.tiles {
             pen.rect(r);
         }
-        for (r, outcome) in strongest(&trace.blocks, |o| match o {
-            BlockOutcome::Rejected => 0,
-            BlockOutcome::Refined => 1,
-            BlockOutcome::Accepted => 2,
-        }) {
-            pen.painter.color = match outcome {
-                BlockOutcome::Rejected => REJECTED,
-                BlockOutcome::Refined => REFINED,
-                BlockOutcome::Accepted => ACCEPTED,
-            };
-            pen.rect(r);
-        }
+        let order = [
+            (BlockOutcome::Rejected, REJECTED),
+            (BlockOutcome::Refined, REFINED),
+            (BlockOutcome::Accepted, ACCEPTED),
+        ];
+        pen.ranked_rects(&trace.blocks, &order);
     }
     if overlays.frusta {
-        for (r, event) in strongest(&trace.frusta, |e| match e {
-            FrustumEvent::Created => 0,
-            FrustumEvent::Split => 1,
-            FrustumEvent::Rasterized => 2,
-        }) {
-            // Split frusta first (their quarters draw over them).
-            pen.painter.color = match event {
-                FrustumEvent::Created => CULLED,
-                FrustumEvent::Split => SPLIT,
-                FrustumEvent::Rasterized => RASTERIZED,
-            };
-            pen.rect(r);
-        }
+        // A frustum never split nor rasterized was culled at every node it met.
+        let order = [
+            (FrustumEvent::Created, CULLED),
+            (FrustumEvent::Split, SPLIT),
+            (FrustumEvent::Rasterized, RASTERIZED),
+        ];
+        pen.ranked_rects(&trace.frusta, &order);
     }
     if overlays.bvh {
         pen.painter.color = NODE;
@@ -139,28 +127,6 @@ pub fn draw_overlays(
     }
 }
 
-/// Per rectangle, its strongest record by `rank`, weakest first (so the
-/// strongest draw last, on top).
-fn strongest<O: Copy>(records: &[(PixelRect, O)], rank: impl Fn(O) -> u8) -> Vec<(PixelRect, O)> {
-    let mut best: HashMap<PixelRect, O> = HashMap::new();
-    for &(r, o) in records {
-        let e = best.entry(r).or_insert(o);
-        if rank(o) > rank(*e) {
-            *e = o;
-        }
-    }
-    let mut out: Vec<(PixelRect, O)> = best.into_iter().collect();
-    out.sort_by_key(|&(r, o)| {
-        (
-            rank(o),
-            std::cmp::Reverse(r.width() * r.height()),
-            r.y0,
-            r.x0,
-        )
-    });
-    out
-}
-
 /// The primitives at one colour, anti-aliased with sixteen samples a pixel.
 struct Pen<'i> {
     painter: Painter<'i>,
@@ -169,6 +135,24 @@ struct Pen<'i> {
 }
 
 impl Pen<'_> {
+    /// Each rectangle of `records` once, in the colour of its strongest
+    /// record (`order`: weakest first), the strongest drawn last, on top,
+    /// and within a rank larger rectangles before the smaller inside them.
+    fn ranked_rects<O: Copy + Eq>(&mut self, records: &[(PixelRect, O)], order: &[(O, [u8; 4])]) {
+        let rank = |o: O| order.iter().position(|(p, _)| *p == o).unwrap_or(0);
+        let mut best: HashMap<PixelRect, usize> = HashMap::new();
+        for &(r, o) in records {
+            let e = best.entry(r).or_insert(0);
+            *e = (*e).max(rank(o));
+        }
+        let mut rects: Vec<(PixelRect, usize)> = best.into_iter().collect();
+        rects.sort_by_key(|&(r, k)| (k, std::cmp::Reverse(r.width() * r.height()), r.y0, r.x0));
+        for (r, k) in rects {
+            self.painter.color = order[k].1;
+            self.rect(r);
+        }
+    }
+
     fn line(&mut self, a: [f64; 2], b: [f64; 2]) {
         // Points come from finite renders; a line that is still bad is skipped.
         let _ = draw::aa_line(a, b, 1.0, &self.positions, self.size, &mut self.painter);

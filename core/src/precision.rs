@@ -4,7 +4,7 @@
 //! |---|---|---|
 //! | `f32` | every algorithm | the default: single precision, one fixed operation order |
 //! | `f64` | 3D family (`3dr-*`, `raycast`) | setup and per-sample evaluation in double precision, vertices relative to the eye |
-//! | `fixed` | 2D family (`2dr-brute`, `2dr-bin`) | vertices snapped to 1/256 pixel (16.8 fixed point) and exact integer edge functions, as hardware does (Direct3D 11 §3.4, Vulkan) |
+//! | `fixed` | 2D family (`2dr-brute`, `2dr-bin`, `2dr-scanline`) | vertices snapped to 1/256 pixel (16.8 fixed point) and exact integer edge functions, as hardware does (Direct3D 11 §3.4, Vulkan) |
 //!
 //! Non-planar viewports evaluate their curved edges in f64 at every precision.
 

@@ -44,13 +44,19 @@ pub struct RenderBody {
 pub enum OverlayWords {
     Text(String),
     List(Vec<String>),
+    /// Anything else: an error naming `overlays`.
+    Other(Value),
 }
 
 impl OverlayWords {
-    fn text(&self) -> String {
+    fn text(&self) -> Result<String, ApiError> {
         match self {
-            OverlayWords::Text(t) => t.clone(),
-            OverlayWords::List(l) => l.join(","),
+            OverlayWords::Text(t) => Ok(t.clone()),
+            OverlayWords::List(l) => Ok(l.join(",")),
+            OverlayWords::Other(v) => Err(ApiError::bad_request(
+                "overlays",
+                format!("{v} is neither a string nor a list of strings"),
+            )),
         }
     }
 }
@@ -60,8 +66,8 @@ const OUTPUTS: [&str; 4] = ["color", "edge_evals", "depth", "triangle_id"];
 
 impl RenderBody {
     /// The body's words, for the front door every front end shares.
-    fn words(&self) -> RenderWords {
-        RenderWords {
+    fn words(&self) -> Result<RenderWords, ApiError> {
+        Ok(RenderWords {
             scene: self.scene.clone(),
             algorithm: self.algorithm.clone(),
             camera: self.camera.clone(),
@@ -71,8 +77,8 @@ impl RenderBody {
             precision: self.precision.clone(),
             texture_filter: self.texture_filter.clone(),
             size: self.size.clone(),
-            overlays: self.overlays.as_ref().map(OverlayWords::text),
-        }
+            overlays: self.overlays.as_ref().map(OverlayWords::text).transpose()?,
+        })
     }
 }
 
@@ -95,7 +101,7 @@ fn check(body: &RenderBody, state: &AppState) -> Result<Checked, ApiError> {
             ),
         ));
     }
-    let settings = body.words().settings()?;
+    let settings = body.words()?.settings()?;
     let (width, height, aa) = (settings.width, settings.height, settings.aa);
     if u64::from(width) * u64::from(height) > state.limits.max_pixels {
         return Err(FieldError::new(

@@ -328,6 +328,14 @@ fn bad_input_is_a_4xx_naming_the_field() {
             "viewport",
         ),
         (
+            r#"{ "scene": "box", "algorithm": "raycast", "overlays": ["frusta", "heat"] }"#,
+            "overlays",
+        ),
+        (
+            r#"{ "scene": "box", "algorithm": "raycast", "overlays": 3 }"#,
+            "overlays",
+        ),
+        (
             r#"{ "scene": "box", "algorithm": "2dr-bin", "precision": "f64" }"#,
             "precision",
         ),
@@ -727,4 +735,50 @@ fn algorithms_say_whether_this_server_runs_them() {
         );
         assert_eq!(a["unavailable_reason"].is_null(), available, "{a}");
     }
+}
+
+/// Overlays over HTTP: as a list or as words, drawn over every image asked
+/// for (the images change, the render's hashes do not), and listed with
+/// their legend by `/api/algorithms`.
+#[test]
+fn overlays_are_drawn_over_the_images() {
+    let s = state(Limits::default());
+    let body = |overlays: &str| {
+        format!(
+            r#"{{ "scene": "teapots", "algorithm": "3dr-frustum-split", "size": "160x120", "outputs": ["color", "edge_evals"] {overlays} }}"#
+        )
+    };
+    let (status, plain) = post(&s, "/api/render", &body(""));
+    assert_eq!(status, StatusCode::OK, "{plain}");
+    for overlays in [
+        r#", "overlays": ["frusta", "tiles"]"#,
+        r#", "overlays": "frusta,tiles""#,
+    ] {
+        let (status, drawn) = post(&s, "/api/render", &body(overlays));
+        assert_eq!(status, StatusCode::OK, "{drawn}");
+        assert_eq!(drawn["hashes"], plain["hashes"]);
+        for key in ["color", "edge_evals"] {
+            assert_ne!(
+                drawn["images"][key], plain["images"][key],
+                "{overlays}: {key}"
+            );
+        }
+    }
+    let (status, png) = get(
+        &s,
+        "/api/render.png?scene=teapots&algorithm=3dr-frustum-split&size=160x120&overlays=frusta",
+    );
+    assert_eq!(status, StatusCode::OK);
+    assert!(png.starts_with(b"\x89PNG"));
+    let (_, listing) = get(&s, "/api/algorithms");
+    let listing: serde_json::Value = serde_json::from_slice(&listing).unwrap();
+    let names = listing["overlays"]["names"].as_array().expect("names");
+    assert_eq!(names.len(), 4);
+    assert!(
+        listing["overlays"]["legend"]
+            .as_array()
+            .expect("legend")
+            .len()
+            >= 8
+    );
 }

@@ -282,6 +282,18 @@ fn bad_arguments_exit_2_naming_the_argument() {
                 "box",
                 "--algorithm",
                 "raycast",
+                "--overlay",
+                "frusta,heat",
+            ],
+            "--overlay",
+        ),
+        (
+            &[
+                "render",
+                "--scene",
+                "box",
+                "--algorithm",
+                "raycast",
                 "--viewport",
                 "fisheye",
             ],

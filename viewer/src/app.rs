@@ -930,7 +930,7 @@ fn overlay_controls(ui: &mut egui::Ui, overlays: &mut Overlays) {
             (
                 &mut overlays.bvh,
                 "bvh",
-                "the projected boxes of the BVH nodes the traversal entered",
+                "the projected boxes of the BVH nodes the traversal or the ray packets entered",
             ),
         ] {
             ui.checkbox(flag, name).on_hover_text(hint);

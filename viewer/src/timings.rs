@@ -171,7 +171,7 @@ pub fn history_plot(ui: &mut egui::Ui, history: &History) {
 
 /// The counters of each labelled render, one column per render.
 pub fn counters_table(ui: &mut egui::Ui, renders: &[(&str, &Stats)]) {
-    let rows: [Row<Stats, u64>; 16] = [
+    let rows: [Row<Stats, u64>; 18] = [
         ("triangle setups", |s| s.triangle_setups),
         ("edge evaluations", |s| s.edge_evaluations),
         ("max per pixel", |s| u64::from(s.max_edge_evals_per_pixel)),
@@ -187,6 +187,8 @@ pub fn counters_table(ui: &mut egui::Ui, renders: &[(&str, &Stats)]) {
         ("tiles accepted", |s| s.counters.tiles_accepted),
         ("tiles rejected", |s| s.counters.tiles_rejected),
         ("early-z rejects", |s| s.counters.early_z_rejects),
+        ("spans", |s| s.counters.spans),
+        ("edge steps", |s| s.counters.edge_steps),
         ("samples shaded", |s| s.shading_samples),
         ("pixels with 1 coverage write", |s| s.coverage_histogram.one),
         ("pixels with 2+ writes", |s| s.coverage_histogram.many),

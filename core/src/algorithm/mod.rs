@@ -4,6 +4,7 @@
 //! |---|---|---|
 //! | `2dr-brute` | all triangles | bounding box, projected 2D edges, near + guard-band clipping |
 //! | `2dr-bin` | all triangles | hierarchical tiles + early-z |
+//! | `2dr-scanline` | all triangles | spans: edges walked row to row, span ends by each edge's decision |
 //! | `2dr-homogeneous` | all triangles | bounding box, homogeneous edges (Olano–Greer), no clipping |
 //! | `3dr-brute` | all triangles | bounding box, 3D edges (paper §3.2), no projection |
 //! | `3dr-bin` | all triangles | hierarchical tiles + early-z |

@@ -20,6 +20,7 @@ use crate::prepared::PreparedScene;
 use crate::prepared::is_see_through;
 use crate::simd::{self, Lanes};
 use crate::stats::Stats;
+use crate::trace::NodeOutcome;
 
 /// Nodes are culled only when entered beyond the best hit's `w` times this: the
 /// computed `w` of a triangle can differ from the exact distance the box test
@@ -106,6 +107,8 @@ fn cast_band_on<L: Lanes, T: Coverage>(
     let pattern = tile.pattern;
     let (stored, pixels) = (pattern.stored, tile.pixels);
     let mut nodes = 0;
+    // The nodes the packets entered, when the render is traced.
+    let mut trace_nodes: Option<Vec<u32>> = tile.trace.is_some().then(Vec::new);
     // Planar perspective views: every ray leaves the eye along
     // `View::direction`, computed here for the packet eight lanes at a time.
     let perspective = view.sphere.is_none() && !view.is_orthographic();
@@ -161,7 +164,8 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                 // opaque hit, behind which no fragment shows.
                 let opacity = tile.opacity;
                 let fragments = &mut tile.fragments;
-                nodes += scene.bvh.walk_packet::<L>(packet, |k, cull| {
+                let entered = trace_nodes.as_mut();
+                nodes += scene.bvh.walk_packet::<L>(packet, entered, |k, cull| {
                     // The box first: most leaf triangles miss a packet's block.
                     let Some((rect, id)) = setups.boxes[k as usize] else {
                         return;
@@ -226,6 +230,14 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                 }
             }
         }
+    }
+    if let Some(mut entered) = trace_nodes {
+        entered.sort_unstable();
+        entered.dedup();
+        tile.record(|t| {
+            let boxes = entered.iter().map(|&n| scene.bvh.node_box(n as usize));
+            t.nodes.extend(boxes.map(|b| (b, NodeOutcome::Entered)));
+        });
     }
     nodes
 }

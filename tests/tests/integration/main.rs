@@ -8,6 +8,7 @@ mod golden;
 mod hard_cases;
 mod loaders;
 mod oracles;
+mod overlays;
 mod tie_rules;
 mod viewports;
 mod watertight;
