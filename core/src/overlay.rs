@@ -160,8 +160,14 @@ impl Pen<'_> {
 
     /// A rectangle's outline, one pixel inside its border.
     fn rect(&mut self, r: PixelRect) {
-        let (x0, y0) = (f64::from(r.x0) + 0.5, f64::from(r.y0) + 0.5);
-        let (x1, y1) = (f64::from(r.x1) - 0.5, f64::from(r.y1) - 0.5);
+        let [x0, y0] = [r.x0, r.y0].map(|v| f64::from(v) + 0.5);
+        let [x1, y1] = [r.x1, r.y1].map(|v| f64::from(v) - 0.5);
+        self.box_outline([x0, y0, x1, y1]);
+    }
+
+    /// The outline of a box in image coordinates `[x0, y0, x1, y1]`: one
+    /// closed stroke, so its corners are drawn once.
+    fn box_outline(&mut self, [x0, y0, x1, y1]: [f64; 4]) {
         let outline = [[x0, y0], [x1, y0], [x1, y1], [x0, y1], [x0, y0]];
         let style = draw::Stroke {
             join: draw::Join::Miter,
@@ -174,18 +180,6 @@ impl Pen<'_> {
             self.size,
             &mut self.painter,
         );
-    }
-
-    /// A box in image coordinates `[x0, y0, x1, y1]`.
-    fn box_outline(&mut self, [x0, y0, x1, y1]: [f64; 4]) {
-        for (a, b) in [
-            ([x0, y0], [x1, y0]),
-            ([x1, y0], [x1, y1]),
-            ([x1, y1], [x0, y1]),
-            ([x0, y1], [x0, y0]),
-        ] {
-            self.line(a, b);
-        }
     }
 
     fn circle(&mut self, c: [f64; 2], r: f64) {

@@ -252,7 +252,7 @@ pub fn stroke(
         .fold([f64::INFINITY, f64::NEG_INFINITY], |r, p| {
             [r[0].min(p[1]), r[1].max(p[1])]
         });
-    let pad = style.width * style.miter_limit.max(1.0);
+    let pad = style.width * style.miter_limit;
     let first = (reach[0] - pad).floor().max(0.0) as u32;
     let end = (reach[1] + pad).ceil().min(height).max(0.0) as u32;
     let mut spans: Vec<([f64; 2], usize)> = Vec::new();
