@@ -74,17 +74,46 @@ pub(crate) fn pipeline_for(
             ),
         ));
     }
+    if matches!(pipeline, Pipeline::Compute(_)) && !COMPUTE_AA.contains(&request.aa) {
+        return Err(FieldError::new(
+            "aa",
+            format!(
+                "{algorithm} renders aa none, msaa:2, msaa:4 and ssaa:4 (at most four stored samples, no coverage-only ones); not aa {}",
+                request.aa
+            ),
+        ));
+    }
+    if !request.depth_test && !matches!(pipeline, Pipeline::Compute(_)) {
+        return Err(FieldError::new(
+            "depth_test",
+            format!(
+                "{algorithm} always keeps the nearest sample; the depth test can be off for gpu-2dr, gpu-2dr-homogeneous, gpu-3dr and gpu-3dr-binned (the paper's section 5 experiment)"
+            ),
+        ));
+    }
     if let Some(why) = unavailable(algorithm) {
         return Err(FieldError::new("algorithm", why));
     }
-    if pipeline == Pipeline::Gpu && scene.is_some_and(|s| !s.triangle_opacity.is_empty()) {
+    let on_gpu = matches!(pipeline, Pipeline::Gpu | Pipeline::Compute(_));
+    if on_gpu && scene.is_some_and(|s| !s.triangle_opacity.is_empty()) {
         return Err(FieldError::new(
             "algorithm",
-            "gpu-raster draws opaque surfaces only; this scene has see-through materials (opacity < 1)",
+            format!(
+                "{algorithm} draws opaque surfaces only; this scene has see-through materials (opacity < 1)"
+            ),
         ));
     }
     Ok(pipeline)
 }
+
+/// The anti-aliasing modes the compute kernels render: at most four stored
+/// samples, each also a coverage sample.
+const COMPUTE_AA: [AaMode; 4] = [
+    AaMode::None,
+    AaMode::Msaa(2),
+    AaMode::Msaa(4),
+    AaMode::Ssaa(4),
+];
 
 /// Why this process cannot run `algorithm` on this machine, or `None` when it
 /// can: `gpu-raster` needs the `gpu` feature and a device that renders its
@@ -92,7 +121,7 @@ pub(crate) fn pipeline_for(
 /// names; [`check`] refuses it with the same message.
 pub fn unavailable(algorithm: AlgorithmId) -> Option<String> {
     match algorithm.pipeline() {
-        Pipeline::Gpu => gpu_unavailable(),
+        Pipeline::Gpu | Pipeline::Compute(_) => gpu_unavailable(),
         _ => None,
     }
 }
@@ -104,6 +133,34 @@ pub fn gpu_adapter() -> Option<String> {
     return crate::gpu::gpu().ok().map(|g| g.adapter.clone());
     #[cfg(not(feature = "gpu"))]
     None
+}
+
+/// Chooses the GPU adapter by a (case-insensitive) part of its name, for
+/// every GPU algorithm of this process (`--adapter`; `CONTINUUM_ADAPTER`
+/// otherwise). Only a choice made before the first GPU render counts:
+/// returns whether this one did.
+pub fn choose_gpu_adapter(name: &str) -> bool {
+    #[cfg(feature = "gpu")]
+    return crate::gpu::choose_adapter(name);
+    #[cfg(not(feature = "gpu"))]
+    {
+        let _ = name;
+        false
+    }
+}
+
+/// Makes the GPU compute kernels keep visibility with two passes of 32-bit
+/// atomics even where 64-bit `atomicMin` exists (`CONTINUUM_GPU_ATOMICS=two-pass`
+/// does the same): the fallback, testable on any adapter.
+pub fn force_gpu_two_pass(on: bool) {
+    #[cfg(feature = "gpu")]
+    crate::gpu::set_atomics(if on {
+        crate::gpu::GpuAtomics::TwoPass
+    } else {
+        crate::gpu::GpuAtomics::Auto
+    });
+    #[cfg(not(feature = "gpu"))]
+    let _ = on;
 }
 
 #[cfg(feature = "gpu")]

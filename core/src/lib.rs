@@ -73,7 +73,7 @@ pub mod internal;
 
 pub use aa::AaMode;
 pub use camera::{Camera, View, pixel_center};
-pub use capability::{check, gpu_adapter, unavailable};
+pub use capability::{check, choose_gpu_adapter, force_gpu_two_pass, gpu_adapter, unavailable};
 pub use color::{BACKGROUND_COLOR, decode_srgb};
 pub use effects::EffectStats;
 pub use framebuffer::{BACKGROUND, Framebuffer};
@@ -86,7 +86,7 @@ pub use render::{RenderOutput, RenderSummary, render, render_cancellable};
 pub use request::RenderRequest;
 pub use scene::{Scene, SceneError};
 pub use simd::{Isa, isa};
-pub use stats::{CoverageHistogram, Hashes, RasterCounters, StageTimes, Stats};
+pub use stats::{CoverageHistogram, GpuTimes, Hashes, RasterCounters, StageTimes, Stats};
 pub use texture::TextureFilter;
 pub use trace::{BlockOutcome, FrustumEvent, NodeOutcome, Overlays, Trace};
 pub use viewport::Viewport;

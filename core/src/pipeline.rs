@@ -172,6 +172,33 @@ pub enum Pipeline {
     Rays,
     /// The GPU's hardware pipeline.
     Gpu,
+    /// The continuum's own edge functions as GPU compute kernels (paper §5).
+    Compute(ComputeKind),
+}
+
+/// Which compute kernels render a GPU algorithm of the continuum.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ComputeKind {
+    /// `gpu-2dr`: projected 2D edge functions (§3.1), clipped triangles set
+    /// up by the CPU.
+    TwoD,
+    /// `gpu-2dr-homogeneous`: Olano–Greer, no clipping.
+    Homogeneous,
+    /// `gpu-3dr`: 3D edge functions (§3.2–3.4), no projection, no clipping.
+    ThreeD,
+    /// `gpu-3dr-binned`: 3D edge functions in a sort-middle pipeline.
+    ThreeDBinned,
+}
+
+impl ComputeKind {
+    /// The edge functions the kernels set up.
+    pub fn edges(self) -> EdgeKind {
+        match self {
+            ComputeKind::TwoD => EdgeKind::TwoD,
+            ComputeKind::Homogeneous => EdgeKind::Homogeneous,
+            ComputeKind::ThreeD | ComputeKind::ThreeDBinned => EdgeKind::ThreeD,
+        }
+    }
 }
 
 impl AlgorithmId {
@@ -223,6 +250,10 @@ impl AlgorithmId {
             AlgorithmId::ThreeDFull => frusta(true, true, Some(8), SampleOracles::BINNED),
             AlgorithmId::Raycast => Pipeline::Rays,
             AlgorithmId::GpuRaster => Pipeline::Gpu,
+            AlgorithmId::Gpu2dr => Pipeline::Compute(ComputeKind::TwoD),
+            AlgorithmId::Gpu2drHomogeneous => Pipeline::Compute(ComputeKind::Homogeneous),
+            AlgorithmId::Gpu3dr => Pipeline::Compute(ComputeKind::ThreeD),
+            AlgorithmId::Gpu3drBinned => Pipeline::Compute(ComputeKind::ThreeDBinned),
         }
     }
 }
@@ -243,7 +274,9 @@ impl Pipeline {
             Pipeline::AllTriangles { samples, .. } => samples,
             Pipeline::Frusta(t) => &mut t.samples,
             Pipeline::Rays => return Err(bad("raycast takes no oracles")),
-            Pipeline::Gpu => return Err(bad("gpu-raster takes no oracles")),
+            Pipeline::Gpu | Pipeline::Compute(_) => {
+                return Err(bad("the GPU algorithms take no oracles"));
+            }
         };
         let set = |to: &mut bool, v: Option<bool>| *to = v.unwrap_or(*to);
         set(&mut samples.binning, oracles.binning);
@@ -293,24 +326,23 @@ impl Pipeline {
         match self {
             Pipeline::AllTriangles { samples, .. } => Some(samples),
             Pipeline::Frusta(t) => Some(t.samples),
-            Pipeline::Rays | Pipeline::Gpu => None,
+            Pipeline::Rays | Pipeline::Gpu | Pipeline::Compute(_) => None,
         }
     }
 
     /// The paper's Fig. 10 scalar instruction costs: (setup, per sample); the
     /// GPU's are not modelled (zero).
     pub fn instruction_costs(self) -> (u64, u64) {
-        match self {
-            Pipeline::Gpu => (0, 0),
-            Pipeline::AllTriangles {
-                edges: EdgeKind::TwoD,
-                ..
-            } => (72, 14),
-            Pipeline::AllTriangles {
-                edges: EdgeKind::Homogeneous,
-                ..
-            } => (73, 14),
-            _ => (57, 12),
+        let edges = match self {
+            Pipeline::Gpu => return (0, 0),
+            Pipeline::AllTriangles { edges, .. } => edges,
+            Pipeline::Compute(kind) => kind.edges(),
+            Pipeline::Frusta(_) | Pipeline::Rays => EdgeKind::ThreeD,
+        };
+        match edges {
+            EdgeKind::TwoD => (72, 14),
+            EdgeKind::Homogeneous => (73, 14),
+            EdgeKind::ThreeD => (57, 12),
         }
     }
 }

@@ -98,6 +98,7 @@ pub fn render_cancellable(
         opacity: &scene.triangle_opacity,
         cancel,
         trace: request.trace,
+        depth_test: request.depth_test,
     };
     // Every path resolves every pixel through `Framebuffer::tile_planes`.
     let start = Instant::now();

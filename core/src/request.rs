@@ -28,6 +28,11 @@ pub struct RenderRequest {
     /// Record what the algorithm does ([`crate::Trace`]: tiles, binning's
     /// blocks, frusta, BVH nodes) for overlays; off, nothing is recorded.
     pub trace: bool,
+    /// Keep the nearest sample (on, the default). Off — the paper's §5 GPU
+    /// experiment, "we disabled depth-buffering and output all results
+    /// colour-coded" — each sample keeps the smallest id covering it, with
+    /// that triangle's depth; only the GPU compute algorithms render so.
+    pub depth_test: bool,
 }
 
 impl RenderRequest {
@@ -44,6 +49,7 @@ impl RenderRequest {
             precision: Precision::F32,
             texture_filter: TextureFilter::default(),
             trace: false,
+            depth_test: true,
         }
     }
 }

@@ -93,6 +93,28 @@ pub struct Stats {
     /// The effects the scene called for and what each cost (empty when it
     /// calls for none).
     pub effects: Vec<crate::effects::EffectStats>,
+    /// The GPU compute algorithms: the device's own time per stage.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gpu: Option<GpuTimes>,
+}
+
+/// Per stage of a GPU compute render, the device's time in milliseconds and
+/// how it was measured.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct GpuTimes {
+    /// The adapter's name, driver and backend.
+    pub adapter: String,
+    /// `timestamps` (the adapter's timestamp queries around each pass) or
+    /// `wall` (host time from submit to a finished device poll).
+    pub clock: String,
+    pub setup: f64,
+    pub binning: f64,
+    pub raster: f64,
+    /// Copy to host-visible memory, map and read (host wall time).
+    pub readback: f64,
+    /// How visibility was kept: `64-bit` (one atomic per sample),
+    /// `32-bit two-pass`, or `none (registers)` (binned: a thread per pixel).
+    pub atomics: String,
 }
 
 /// Hex xxh3-64 hashes of the result buffers (little-endian bytes), for comparing

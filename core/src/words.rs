@@ -161,6 +161,7 @@ impl Settings {
             precision: self.precision,
             texture_filter: self.texture_filter,
             trace: self.overlays.need_trace(),
+            depth_test: true,
         })
     }
 

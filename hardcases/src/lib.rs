@@ -348,6 +348,10 @@ fn counts_every_fragment(a: AlgorithmId) -> bool {
             | AlgorithmId::ThreeDBrute
             | AlgorithmId::ThreeDFrustumCull
             | AlgorithmId::GpuRaster
+            | AlgorithmId::Gpu2dr
+            | AlgorithmId::Gpu2drHomogeneous
+            | AlgorithmId::Gpu3dr
+            | AlgorithmId::Gpu3drBinned
     )
 }
 

@@ -22,6 +22,12 @@ mod serve;
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
+    /// GPU adapter for the GPU algorithms: a case-insensitive part of its name
+    /// (e.g. `llvmpipe`); CONTINUUM_ADAPTER otherwise; the first high-performance
+    /// adapter without either. CONTINUUM_GPU_ATOMICS=two-pass forces the compute
+    /// kernels' 32-bit visibility.
+    #[arg(long, global = true)]
+    adapter: Option<String>,
 }
 
 #[derive(Subcommand, Debug)]
@@ -49,6 +55,9 @@ fn main() -> ExitCode {
         unsafe { std::env::set_var("XDG_RUNTIME_DIR", dir) };
     }
     let cli = Cli::parse();
+    if let Some(name) = &cli.adapter {
+        continuum::choose_gpu_adapter(name);
+    }
     let result = match cli.command {
         Some(Command::Render(args)) => cli_render::run(&args),
         Some(Command::Compare(args)) => compare::run(&args),

@@ -899,7 +899,18 @@ fn compare_without_vulkan_leaves_gpu_raster_out_unless_named() {
                 .as_str()
                 .is_some_and(|a| a.starts_with("peer-")))
             .count(),
-        continuum::AlgorithmId::ALL.len() - 1
+        continuum::AlgorithmId::ALL.len() - continuum::AlgorithmId::GPU.len()
+    );
+    let not_run: Vec<&str> = doc["not_run"]
+        .as_array()
+        .expect("not_run")
+        .iter()
+        .filter_map(|n| n["algorithm"].as_str())
+        .collect();
+    assert_eq!(
+        not_run,
+        continuum::AlgorithmId::GPU.map(|a| a.as_str()),
+        "every GPU algorithm is left out"
     );
     let report = std::fs::read_to_string(dir.join("report.html")).expect("report");
     assert!(report.contains("Not run on this machine") && report.contains("gpu-raster"));

@@ -63,6 +63,10 @@ struct Args {
     /// Render the first frame, save a screenshot of the whole window here (PNG), exit.
     #[arg(long)]
     screenshot: Option<PathBuf>,
+    /// GPU adapter for the GPU algorithms, a case-insensitive part of its
+    /// name (CONTINUUM_ADAPTER otherwise).
+    #[arg(long)]
+    adapter: Option<String>,
 }
 
 /// mimalloc reuses the frame-sized buffers every render allocates (see the server's).
@@ -76,6 +80,9 @@ fn main() -> ExitCode {
         unsafe { std::env::set_var("XDG_RUNTIME_DIR", dir) };
     }
     let args = Args::parse();
+    if let Some(name) = &args.adapter {
+        continuum::choose_gpu_adapter(name);
+    }
     let usage = |message: String| {
         eprintln!("error: {message}");
         ExitCode::from(2)

@@ -13,7 +13,11 @@
 //! | `3dr-full` | as split | binning + early-z at leaves |
 //! | `raycast` | CWBVH walked per ray | one sample per ray, the same 3D edges |
 //! | `gpu-raster` | the wgpu hardware pipeline (feature `gpu`) | the driver's fixed-point rules |
+//! | `gpu-2dr`, `gpu-2dr-homogeneous`, `gpu-3dr` | wgpu compute: setup kernel, one thread per triangle | bounding box |
+//! | `gpu-3dr-binned` | wgpu compute: setup → bin → prefix sum → a workgroup per tile | tile tests, then per pixel |
 
+#[cfg(feature = "gpu")]
+mod gpu_compute;
 mod raycast;
 pub(crate) mod setup2d;
 pub(crate) mod setup3d;
@@ -128,6 +132,7 @@ pub(crate) fn run(
             raycast::render_raycast(scene, context, fb, stats, Triangle3D::setup_eight)
         }
         Pipeline::Gpu => return render_gpu(scene, context, fb, stats).map(|()| None),
+        Pipeline::Compute(kind) => compute(scene, kind, context, fb, stats)?,
     };
     stats.time_ms.store += pass.store_ms;
     stats.counters = pass.counters;
@@ -137,9 +142,10 @@ pub(crate) fn run(
     Ok(pass.trace)
 }
 
-/// Why `gpu-raster` cannot run in a build without the `gpu` feature.
+/// Why the GPU algorithms cannot run in a build without the `gpu` feature.
 #[cfg(not(feature = "gpu"))]
-pub(crate) const NO_GPU_FEATURE: &str = "gpu-raster needs continuum built with the `gpu` feature";
+pub(crate) const NO_GPU_FEATURE: &str =
+    "the GPU algorithms need continuum built with the `gpu` feature";
 
 /// `gpu-raster`: one sample per pixel through the hardware pipeline, read
 /// back and resolved by the CPU's resolve.
@@ -150,15 +156,8 @@ fn render_gpu(
     fb: &mut Framebuffer,
     stats: &mut Stats,
 ) -> Result<(), FieldError> {
-    use crate::gpu::GpuError;
-    crate::gpu::render_gpu_raster(scene, context.view, &context.shader, fb, stats).map_err(|e| {
-        let field = match e {
-            GpuError::TooLarge { .. } => "size",
-            GpuError::SceneTooLarge { .. } => "scene",
-            _ => "algorithm",
-        };
-        FieldError::new(field, e.to_string())
-    })
+    crate::gpu::render_gpu_raster(scene, context.view, &context.shader, fb, stats)
+        .map_err(|e| FieldError::new(e.field(), e.to_string()))
 }
 
 #[cfg(not(feature = "gpu"))]
@@ -168,6 +167,20 @@ fn render_gpu(
     _: &mut Framebuffer,
     _: &mut Stats,
 ) -> Result<(), FieldError> {
+    Err(FieldError::new("algorithm", NO_GPU_FEATURE))
+}
+
+#[cfg(feature = "gpu")]
+use gpu_compute::render_compute as compute;
+
+#[cfg(not(feature = "gpu"))]
+fn compute(
+    _: &PreparedScene,
+    _: crate::pipeline::ComputeKind,
+    _: &TileContext,
+    _: &mut Framebuffer,
+    _: &mut Stats,
+) -> Result<Pass, FieldError> {
     Err(FieldError::new("algorithm", NO_GPU_FEATURE))
 }
 
@@ -244,6 +257,8 @@ pub(crate) struct TileContext<'a> {
     pub cancel: &'a std::sync::atomic::AtomicBool,
     /// Record each tile's [`Trace`].
     pub trace: bool,
+    /// Keep the nearest sample (off: the GPU compute kernels' §5 mode).
+    pub depth_test: bool,
 }
 
 /// A tile rendered and resolved by one worker, with what its rendering returned.

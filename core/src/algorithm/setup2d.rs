@@ -20,11 +20,16 @@ use crate::prepared::PreparedScene;
 /// Every drawable triangle, clipped, projected and set up with f32 edge
 /// functions; pieces without samples on screen are dropped.
 pub(crate) fn setup_2d(scene: &PreparedScene, view: &View, span: SampleSpan) -> Setups<Triangle2D> {
+    setup_pieces(scene, view, span, [GUARD_BAND; 2], make_2d(view))
+}
+
+/// The f32 setup of one projected piece, with its vertex bounds.
+fn make_2d(view: &View) -> impl Fn(&[ScreenVertex; 3]) -> Option<(Triangle2D, [f32; 4])> + Sync {
     let affine = view.is_orthographic();
-    setup_pieces(scene, view, span, [GUARD_BAND; 2], |v| {
+    move |v| {
         let t = Triangle2D::setup(v, affine, view.width, view.height)?;
         Some((t, t.bounds))
-    })
+    }
 }
 
 /// As [`setup_2d`], with vertices snapped to 1/256 pixel and exact edge
@@ -99,6 +104,27 @@ fn setup_pieces<T: Send>(
         triangles.push(t);
     }
     Setups { boxes, triangles }
+}
+
+/// The set-up pieces of the triangles `ids` after clipping (near plane and
+/// guard band, in f64), each with its pixels and its triangle's id: what
+/// [`setup_2d`] makes of the triangles it clips.
+pub(crate) fn clipped_pieces(
+    scene: &PreparedScene,
+    view: &View,
+    span: SampleSpan,
+    ids: &[u32],
+) -> Vec<(Triangle2D, PixelRect, u32)> {
+    let make = make_2d(view);
+    let planes = pipeline_planes(view, [GUARD_BAND; 2]);
+    ids.par_iter()
+        .flat_map_iter(|&id| {
+            pieces_of(scene, view, span, &planes, &make, id)
+                .into_iter()
+                .flatten()
+                .map(|p| (p.tri, p.rect, p.id))
+        })
+        .collect()
 }
 
 /// Items' boxes and triangles, before they are [`Setups`].

@@ -111,6 +111,33 @@ impl Triangle2D {
         Some(t)
     }
 
+    /// The triangle as the GPU kernels read it (`Tri` in `gpu/compute.wgsl`,
+    /// 2D layout): rows 0..2 `(lo, Δ)` per edge, row 3 `(signs, q0)`, row 4
+    /// `(q1, q2, w_min, w_max)`; and the flags (tie ownership per edge, 2D,
+    /// affine).
+    pub(crate) fn gpu_rows(&self) -> ([[f32; 4]; 5], u32) {
+        let edge = |i: usize| {
+            [
+                self.lo[i][0],
+                self.lo[i][1],
+                self.delta[i][0],
+                self.delta[i][1],
+            ]
+        };
+        let mut flags = 8 | if self.affine { 16 } else { 0 };
+        for (i, &owns) in self.owns.iter().enumerate() {
+            flags |= u32::from(owns) << i;
+        }
+        let rows = [
+            edge(0),
+            edge(1),
+            edge(2),
+            [self.sign[0], self.sign[1], self.sign[2], self.q[0]],
+            [self.q[1], self.q[2], self.w_range[0], self.w_range[1]],
+        ];
+        (rows, flags)
+    }
+
     /// Canonical (unsigned) edge function `(hi − lo) × (p − lo)`.
     #[inline(always)]
     fn raw(&self, i: usize, x: f32, y: f32) -> f32 {

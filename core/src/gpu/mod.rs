@@ -15,6 +15,9 @@
 //! them (lavapipe: vertices snapped to 1/256 pixel, top-left rule); the
 //! conformance tests compare it with `--precision fixed`.
 
+mod compute;
+
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
@@ -25,6 +28,9 @@ use crate::prepared::PreparedScene;
 use crate::resolve::finish_tile;
 use crate::shade::Shader;
 use crate::stats::Stats;
+
+pub use compute::GpuAtomics;
+pub(crate) use compute::{ComputeSamples, TriWords};
 
 /// Why the GPU path cannot render.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -37,9 +43,61 @@ pub enum GpuError {
     TooLarge { width: u32, height: u32, max: u32 },
     #[error("the scene's {vertices} vertices exceed the GPU's largest buffer")]
     SceneTooLarge { vertices: u64 },
+    #[error("the {what} buffer needs {bytes} bytes; the GPU's largest storage buffer holds {max}")]
+    BufferTooLarge {
+        what: String,
+        bytes: u64,
+        max: u64,
+        /// The request field that sized it (`size` or `scene`).
+        field: &'static str,
+    },
     #[error("GPU failure: {0}")]
     Failed(String),
 }
+
+impl GpuError {
+    /// The request field at fault.
+    pub(crate) fn field(&self) -> &'static str {
+        match self {
+            GpuError::TooLarge { .. } => "size",
+            GpuError::SceneTooLarge { .. } => "scene",
+            GpuError::BufferTooLarge { field, .. } => field,
+            GpuError::NoDevice(_) | GpuError::Failed(_) => "algorithm",
+        }
+    }
+}
+
+/// The adapter to open, by name (a case-insensitive part of it), set before
+/// the first render (`--adapter`); `CONTINUUM_ADAPTER` otherwise.
+static ADAPTER_CHOICE: OnceLock<String> = OnceLock::new();
+
+/// Forces the compute kernels' 32-bit two-pass visibility (`--gpu-atomics
+/// two-pass`; `CONTINUUM_GPU_ATOMICS=two-pass`).
+static FORCE_TWO_PASS: AtomicBool = AtomicBool::new(false);
+
+/// Chooses the adapter by name; only the first choice, made before the GPU
+/// is opened, counts. Returns whether it was taken.
+pub fn choose_adapter(name: &str) -> bool {
+    ADAPTER_CHOICE.set(name.to_string()).is_ok() && GPU_OPENED.get().is_none()
+}
+
+/// Chooses how the compute kernels keep the nearest sample.
+pub fn set_atomics(atomics: GpuAtomics) {
+    FORCE_TWO_PASS.store(atomics == GpuAtomics::TwoPass, Ordering::Relaxed);
+}
+
+/// The visibility the compute kernels use now.
+pub(crate) fn atomics() -> GpuAtomics {
+    let env = std::env::var("CONTINUUM_GPU_ATOMICS").is_ok_and(|v| v == "two-pass");
+    if env || FORCE_TWO_PASS.load(Ordering::Relaxed) {
+        GpuAtomics::TwoPass
+    } else {
+        GpuAtomics::Auto
+    }
+}
+
+/// Set once the GPU has been opened (the adapter can no longer change).
+static GPU_OPENED: OnceLock<()> = OnceLock::new();
 
 /// The device, its queue and the pipeline, made once per process.
 #[derive(Debug)]
@@ -54,21 +112,62 @@ pub struct Gpu {
     max_dimension: u32,
     /// One render at a time: lavapipe uses every core already.
     lock: Mutex<()>,
+    /// The compute kernels, compiled on first use.
+    compute: compute::ComputeCache,
+    /// The device has 64-bit atomicMin/Max on storage buffers.
+    int64_atomics: bool,
+    /// The device has timestamp queries around passes.
+    timestamps: bool,
 }
 
 /// Per-scene vertex data on the device: three vertices per drawable triangle
-/// (positions, and the triangle id on each), in id order.
+/// (positions, and the triangle id on each), in id order, for the hardware
+/// pipeline; the indexed mesh and the drawable ids for the compute kernels.
 #[derive(Debug)]
 pub(crate) struct GpuMesh {
     positions: wgpu::Buffer,
     ids: wgpu::Buffer,
     vertices: u32,
+    /// Per mesh vertex three f32 coordinates.
+    positions_packed: wgpu::Buffer,
+    /// Per triangle its three vertex indices.
+    corners: wgpu::Buffer,
+    /// The drawable triangles' ids.
+    drawable: wgpu::Buffer,
+    /// How many triangles are drawable.
+    triangles: u32,
 }
 
 /// The process's GPU, opened on first use.
 pub fn gpu() -> Result<&'static Gpu, GpuError> {
     static GPU: OnceLock<Result<Gpu, GpuError>> = OnceLock::new();
-    GPU.get_or_init(Gpu::open).as_ref().map_err(Clone::clone)
+    GPU.get_or_init(|| {
+        let _ = GPU_OPENED.set(());
+        Gpu::open()
+    })
+    .as_ref()
+    .map_err(Clone::clone)
+}
+
+/// The adapter `name` names (a case-insensitive part of its name), or an
+/// error listing the adapters there are.
+fn adapter_named(instance: &wgpu::Instance, name: &str) -> Result<wgpu::Adapter, GpuError> {
+    let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::PRIMARY));
+    let names: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
+    let wanted = name.to_lowercase();
+    adapters
+        .into_iter()
+        .find(|a| a.get_info().name.to_lowercase().contains(&wanted))
+        .ok_or_else(|| {
+            GpuError::NoDevice(format!(
+                "no adapter named '{name}' (adapter / CONTINUUM_ADAPTER); adapters here: {}",
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
+            ))
+        })
 }
 
 /// A device error raised outside an error scope, kept for the next draw to
@@ -111,11 +210,19 @@ impl Gpu {
         let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
         descriptor.backends = wgpu::Backends::PRIMARY;
         let instance = wgpu::Instance::new(descriptor.with_env());
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            ..Default::default()
-        }))
-        .map_err(|e| GpuError::NoDevice(e.to_string()))?;
+        let choice = ADAPTER_CHOICE
+            .get()
+            .cloned()
+            .or_else(|| std::env::var("CONTINUUM_ADAPTER").ok())
+            .filter(|n| !n.is_empty());
+        let adapter = match choice {
+            Some(name) => adapter_named(&instance, &name)?,
+            None => pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                ..Default::default()
+            }))
+            .map_err(|e| GpuError::NoDevice(e.to_string()))?,
+        };
         let info = adapter.get_info();
         let adapter_name = format!("{} ({}, {:?})", info.name, info.driver, info.backend);
         let depth_format = if adapter
@@ -144,13 +251,17 @@ impl Gpu {
             }
         }
         let limits = adapter.limits();
+        // Optional features the compute kernels use where the adapter has them.
+        let int64 = wgpu::Features::SHADER_INT64 | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX;
+        let optional = int64 | wgpu::Features::TIMESTAMP_QUERY;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("continuum"),
-            required_features: if depth_format == wgpu::TextureFormat::Depth32FloatStencil8 {
-                wgpu::Features::DEPTH32FLOAT_STENCIL8
-            } else {
-                wgpu::Features::empty()
-            },
+            required_features: (adapter.features() & optional)
+                | if depth_format == wgpu::TextureFormat::Depth32FloatStencil8 {
+                    wgpu::Features::DEPTH32FLOAT_STENCIL8
+                } else {
+                    wgpu::Features::empty()
+                },
             required_limits: limits.clone(),
             ..Default::default()
         }))
@@ -252,15 +363,30 @@ impl Gpu {
             )));
         }
         Ok(Gpu {
-            device,
-            queue,
             pipeline,
             layout,
             depth_format,
             adapter: adapter_name,
             max_dimension: limits.max_texture_dimension_2d,
             lock: Mutex::new(()),
+            compute: Default::default(),
+            int64_atomics: device.features().contains(int64),
+            timestamps: device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
+            device,
+            queue,
         })
+    }
+
+    /// The scene's mesh on the device, uploaded on the first render of the
+    /// prepared scene.
+    pub(crate) fn mesh<'s>(&self, scene: &'s PreparedScene) -> Result<&'s GpuMesh, GpuError> {
+        scene
+            .gpu_cache
+            .get_or_init(|| Box::new(self.upload(scene)))
+            .downcast_ref::<Result<GpuMesh, GpuError>>()
+            .ok_or_else(|| GpuError::Failed("the scene's GPU cache holds another type".into()))?
+            .as_ref()
+            .map_err(Clone::clone)
     }
 
     /// Uploads a scene's drawable triangles.
@@ -288,10 +414,34 @@ impl Gpu {
             self.queue.write_buffer(&b, 0, bytes);
             b
         };
+        let mesh = &scene.scene.mesh;
+        let storage_max = u64::from(self.device.limits().max_storage_buffer_binding_size);
+        if mesh.positions.len() as u64 * 12 > storage_max
+            || mesh.triangles.len() as u64 * 12 > storage_max
+        {
+            return Err(GpuError::SceneTooLarge { vertices });
+        }
+        let packed: Vec<u8> = (mesh.positions.iter())
+            .flat_map(|p| p.to_array())
+            .flat_map(f32::to_le_bytes)
+            .collect();
+        let corners: Vec<u8> = (mesh.triangles.iter())
+            .flatten()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let drawable: Vec<u8> = scene
+            .drawable
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
         Ok(GpuMesh {
             positions: buffer("positions", &positions),
             ids: buffer("ids", &ids),
             vertices: vertices as u32,
+            positions_packed: self.storage("mesh positions", &packed),
+            corners: self.storage("mesh triangles", &corners),
+            drawable: self.storage("drawable", &drawable),
+            triangles: scene.drawable.len() as u32,
         })
     }
 
@@ -508,13 +658,7 @@ pub(crate) fn render_gpu_raster(
     let gpu = gpu()?;
     // 1. Setup: the scene's vertices on the device (once per prepared scene).
     let start = Instant::now();
-    let mesh = scene
-        .gpu_cache
-        .get_or_init(|| Box::new(gpu.upload(scene)))
-        .downcast_ref::<Result<GpuMesh, GpuError>>()
-        .ok_or_else(|| GpuError::Failed("the scene's GPU cache holds another type".into()))?
-        .as_ref()
-        .map_err(Clone::clone)?;
+    let mesh = gpu.mesh(scene)?;
     stats.triangle_setups = scene.drawable.len() as u64;
     stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
     // 2. The draw and its read-back.

@@ -30,9 +30,18 @@ pub enum AlgorithmId {
     Raycast,
     /// The wgpu hardware pipeline (lavapipe without a GPU): reference and peer.
     GpuRaster,
+    /// 2D edge functions as wgpu compute kernels (paper §5).
+    Gpu2dr,
+    /// Homogeneous 2D edge functions as wgpu compute kernels (paper §5).
+    Gpu2drHomogeneous,
+    /// 3D edge functions as wgpu compute kernels (paper §5).
+    Gpu3dr,
+    /// 3D edge functions in a sort-middle compute pipeline (the paper's future work).
+    Gpu3drBinned,
 }
 
-/// The family an algorithm belongs to: within a family results agree bit for bit.
+/// The family an algorithm belongs to: within a family results agree bit for
+/// bit (the GPU's, which round as their driver does, excepted).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum Family {
     /// Projected 2D edge functions.
@@ -50,8 +59,8 @@ pub enum Family {
 }
 
 impl AlgorithmId {
-    /// Every algorithm: the CPU ones and `gpu-raster`.
-    pub const ALL: [AlgorithmId; 11] = [
+    /// Every algorithm: the CPU ones, `gpu-raster` and the compute kernels.
+    pub const ALL: [AlgorithmId; 15] = [
         AlgorithmId::TwoDBrute,
         AlgorithmId::TwoDBin,
         AlgorithmId::TwoDScanline,
@@ -63,6 +72,19 @@ impl AlgorithmId {
         AlgorithmId::ThreeDFull,
         AlgorithmId::Raycast,
         AlgorithmId::GpuRaster,
+        AlgorithmId::Gpu2dr,
+        AlgorithmId::Gpu2drHomogeneous,
+        AlgorithmId::Gpu3dr,
+        AlgorithmId::Gpu3drBinned,
+    ];
+
+    /// The algorithms that run on the GPU (feature `gpu`).
+    pub const GPU: [AlgorithmId; 5] = [
+        AlgorithmId::GpuRaster,
+        AlgorithmId::Gpu2dr,
+        AlgorithmId::Gpu2drHomogeneous,
+        AlgorithmId::Gpu3dr,
+        AlgorithmId::Gpu3drBinned,
     ];
 
     /// The algorithms continuum computes itself, on the CPU: within each family
@@ -93,6 +115,10 @@ impl AlgorithmId {
             AlgorithmId::ThreeDFull => "3dr-full",
             AlgorithmId::Raycast => "raycast",
             AlgorithmId::GpuRaster => "gpu-raster",
+            AlgorithmId::Gpu2dr => "gpu-2dr",
+            AlgorithmId::Gpu2drHomogeneous => "gpu-2dr-homogeneous",
+            AlgorithmId::Gpu3dr => "gpu-3dr",
+            AlgorithmId::Gpu3drBinned => "gpu-3dr-binned",
         }
     }
 
@@ -102,7 +128,11 @@ impl AlgorithmId {
                 Family::TwoD
             }
             AlgorithmId::TwoDHomogeneous => Family::Homogeneous,
-            AlgorithmId::GpuRaster => Family::Gpu,
+            AlgorithmId::GpuRaster
+            | AlgorithmId::Gpu2dr
+            | AlgorithmId::Gpu2drHomogeneous
+            | AlgorithmId::Gpu3dr
+            | AlgorithmId::Gpu3drBinned => Family::Gpu,
             _ => Family::ThreeD,
         }
     }
@@ -138,6 +168,18 @@ impl AlgorithmId {
             }
             AlgorithmId::GpuRaster => {
                 "the GPU's hardware pipeline through wgpu (Mesa lavapipe without a GPU): the reference from outside"
+            }
+            AlgorithmId::Gpu2dr => {
+                "2D rasterization as GPU compute: a setup kernel, then each triangle's bounding box (paper section 5)"
+            }
+            AlgorithmId::Gpu2drHomogeneous => {
+                "homogeneous 2D rasterization as GPU compute, no clipping (paper section 5)"
+            }
+            AlgorithmId::Gpu3dr => {
+                "3D rasterization as GPU compute: 3D edge functions over each bounding box (paper section 5)"
+            }
+            AlgorithmId::Gpu3drBinned => {
+                "3D rasterization in a GPU sort-middle pipeline: setup, bin into tiles, one workgroup per tile"
             }
         }
     }

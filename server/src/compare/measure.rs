@@ -12,8 +12,8 @@ use super::peer::run_peer;
 use anyhow::Context;
 use continuum::metrics::{self, ImageError};
 use continuum::{
-    AaMode, AlgorithmId, Camera, Framebuffer, Precision, PreparedScene, RenderRequest, StageTimes,
-    View, maps, render,
+    AaMode, AlgorithmId, Camera, Family, Framebuffer, Precision, PreparedScene, RenderRequest,
+    StageTimes, View, maps, render,
 };
 use serde_json::{Value, json};
 
@@ -98,19 +98,21 @@ pub fn measure_cell(
             )
             .is_ok(),
             // Peers cast one ray per pixel in their own precision.
-            Entry::Peer(_) => cell.aa == AaMode::None && cell.precision == Precision::F32,
+            Entry::Peer(_) => {
+                cell.aa == AaMode::None && cell.precision == Precision::F32 && cell.depth_test
+            }
         })
         .collect();
     // 2. continuum's CPU algorithms, timed interleaved: one warm-up render
     //    each, then `repeat` rounds of one render per algorithm, so slow drift
     //    of the machine reaches every algorithm of the cell alike and the
-    //    ratios between them stay fair. (`gpu-raster` is timed in a block of
-    //    its own like the peers: lavapipe's threads outlive its frames and
-    //    would slow whichever render came next.)
+    //    ratios between them stay fair. (The GPU algorithms are timed each in
+    //    a block of its own like the peers: lavapipe's threads outlive its
+    //    frames and would slow whichever render came next.)
     let algorithms: Vec<AlgorithmId> = serving
         .iter()
         .filter_map(|e| match e {
-            Entry::Algorithm(a) if *a != AlgorithmId::GpuRaster => Some(*a),
+            Entry::Algorithm(a) if a.family() != Family::Gpu => Some(*a),
             _ => None,
         })
         .collect();
@@ -139,13 +141,12 @@ pub fn measure_cell(
             entry.name()
         ));
         let mut m = match entry {
-            Entry::Algorithm(AlgorithmId::GpuRaster) => {
-                let request = algorithm_request(AlgorithmId::GpuRaster, &camera, cell, sweep);
+            Entry::Algorithm(a) if a.family() == Family::Gpu => {
+                let request = algorithm_request(a, &camera, cell, sweep);
                 let (out, times) = time_interleaved(pool, scene, &[request], sweep.repeat)?
                     .pop()
-                    .context("one timed render for gpu-raster")?;
-                let cell = (AlgorithmId::GpuRaster, cell);
-                algorithm_row(scene, cell, sweep, threads, out, times)
+                    .with_context(|| format!("one timed render for {a}"))?;
+                algorithm_row(scene, (a, cell), sweep, threads, out, times)
             }
             Entry::Algorithm(a) => {
                 let (out, times) = timed.next().context("one timed render per algorithm")?;
@@ -207,6 +208,7 @@ fn algorithm_request(
     RenderRequest {
         aa: cell.aa,
         precision: cell.precision,
+        depth_test: cell.depth_test,
         ..RenderRequest::new(algorithm, camera.clone(), sweep.size.0, sweep.size.1)
     }
 }
@@ -291,6 +293,7 @@ fn algorithm_row(
     row.visibility_ms = Some(super::median(times.visibility).0);
     row.stage_ms = Some(median_stages(&times.stages));
     row.precision = cell.precision;
+    row.depth_test = cell.depth_test;
     row.shading_samples = out.stats.shading_samples;
     row.coverage_samples = out.stats.coverage_samples;
     let fb = out.framebuffer;

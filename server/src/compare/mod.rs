@@ -109,6 +109,9 @@ pub struct Row {
     pub viewport: String,
     pub aa: String,
     pub precision: Precision,
+    /// Off in the paper's §5 GPU experiment (the sweep's `depth_test`).
+    #[serde(default = "depth_test_on")]
+    pub depth_test: bool,
     pub width: u32,
     pub height: u32,
     pub threads: usize,
@@ -175,6 +178,7 @@ impl Row {
             viewport: String::new(),
             aa: String::new(),
             precision: Precision::F32,
+            depth_test: true,
             width,
             height,
             threads,
@@ -331,6 +335,7 @@ fn sweep_from_flags(args: &CompareArgs) -> SweepFile {
             many => Some(sweep::Threads::Each(many.to_vec())),
         },
         camera: args.camera.clone(),
+        depth_test: None,
     }
 }
 
@@ -346,6 +351,7 @@ pub fn relate(rows: &mut [Row]) {
             r.viewport.clone(),
             r.camera.clone(),
             r.threads,
+            r.depth_test,
         )
     };
     let brute: HashMap<_, (f64, Option<f64>)> = rows
@@ -370,7 +376,7 @@ pub fn relate(rows: &mut [Row]) {
     let same = |r: &Row| {
         let (scene, camera) = (r.scene.clone(), r.camera.clone());
         let what = (r.algorithm.clone(), r.aa.clone(), r.precision);
-        (scene, r.viewport.clone(), camera, what)
+        (scene, r.viewport.clone(), camera, r.depth_test, what)
     };
     let mut fewest: HashMap<_, (usize, f64)> = HashMap::new();
     for r in rows.iter() {
@@ -617,6 +623,10 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
 }
 
 /// The rows as a table for the terminal.
+fn depth_test_on() -> bool {
+    true
+}
+
 fn table_text(rows: &[Row]) -> String {
     use std::fmt::Write;
     let mut out = String::new();
@@ -645,13 +655,18 @@ fn table_text(rows: &[Row]) -> String {
     .ok();
     for r in rows {
         let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.2}"));
+        let aa = if r.depth_test {
+            r.aa.clone()
+        } else {
+            format!("{} no-z", r.aa)
+        };
         writeln!(
             out,
             "{:<16} {:<18} {:<16} {:<10} {:<5} {:>3} {:>10.2} {:>8} {:>9} {:>7} {:>7} {:>6} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
             r.scene,
             r.algorithm,
             r.viewport,
-            r.aa,
+            aa,
             r.precision,
             r.threads,
             r.median_ms,
@@ -673,6 +688,12 @@ fn table_text(rows: &[Row]) -> String {
             }
         )
         .ok();
+    }
+    if let Some(table) = report::sect5_rows(rows) {
+        writeln!(out, "\n{}", report::SECT5_TITLE).ok();
+        for line in table {
+            writeln!(out, "{}", line.join("  ")).ok();
+        }
     }
     out
 }

@@ -65,6 +65,7 @@ pre {{ background: #f7f7f7; padding: 8px; font-size: 11px; overflow-x: auto; }}
             "<h2 id=\"aa\">Anti-aliasing: accuracy against time</h2>\n<p>Mean FLIP against a <code>ssaa:256</code> reference, time on a log scale; dashed: the Pareto front.</p>\n{svg}\n"
         );
     }
+    sect5(&mut h, rows);
     peers(&mut h, rows);
     agreement(&mut h, rows);
     all_rows(&mut h, rows);
@@ -117,6 +118,7 @@ fn groups(rows: &[Row]) -> Vec<Vec<&Row>> {
                 &f.aa,
                 f.precision,
                 f.threads,
+                f.depth_test,
             ) == (
                 &r.scene,
                 &r.viewport,
@@ -124,6 +126,7 @@ fn groups(rows: &[Row]) -> Vec<Vec<&Row>> {
                 &r.aa,
                 r.precision,
                 r.threads,
+                r.depth_test,
             )
         }) {
             Some(g) => g.push(r),
@@ -367,6 +370,84 @@ fn edge_maps(h: &mut String, rows: &[Row], maps_root: &Path) {
 }
 
 /// The peers beside the ray caster and the fastest of continuum's own.
+/// The algorithms of the paper's §5 GPU comparison, in table order; the
+/// ratios are to `gpu-3dr`'s frame rate.
+const SECT5: [&str; 5] = [
+    "gpu-2dr",
+    "gpu-2dr-homogeneous",
+    "gpu-3dr",
+    "gpu-3dr-binned",
+    "gpu-raster",
+];
+
+pub const SECT5_TITLE: &str = "GPU shaders side by side (paper section 5): frames per second, and in brackets each over gpu-3dr's";
+
+/// The §5 table as text cells, a header and one line per scene, viewport,
+/// aa and depth-test setting: the scene's triangles, then per algorithm its
+/// fps (median) and its fps over `gpu-3dr`'s. `None` without a `gpu-3dr` row.
+pub fn sect5_rows(rows: &[Row]) -> Option<Vec<Vec<String>>> {
+    if !rows.iter().any(|r| r.algorithm == "gpu-3dr") {
+        return None;
+    }
+    let mut out = vec![
+        ["scene", "triangles", "size", "aa", "depth test"]
+            .iter()
+            .map(|s| format!("{s:>12}"))
+            .chain(SECT5.iter().map(|a| format!("{a:>22}")))
+            .collect(),
+    ];
+    for group in groups(rows) {
+        let fps = |name: &str| {
+            group
+                .iter()
+                .find(|r| r.algorithm == name)
+                .map(|r| 1e3 / r.median_ms)
+        };
+        let Some(base) = fps("gpu-3dr") else { continue };
+        let r = group[0];
+        let triangles = r.stats["triangle_setups"].as_u64().unwrap_or(0);
+        let mut line: Vec<String> = [
+            r.scene.clone(),
+            triangles.to_string(),
+            format!("{}x{}", r.width, r.height),
+            r.aa.clone(),
+            (if r.depth_test { "on" } else { "off" }).to_string(),
+        ]
+        .iter()
+        .map(|s| format!("{s:>12}"))
+        .collect();
+        for name in SECT5 {
+            line.push(match fps(name) {
+                Some(f) => format!("{:>22}", format!("{f:.2} ({:.3})", f / base)),
+                None => format!("{:>22}", "–"),
+            });
+        }
+        out.push(line);
+    }
+    Some(out)
+}
+
+/// The paper's §5 table: the GPU algorithms' frame rates side by side.
+fn sect5(h: &mut String, rows: &[Row]) {
+    let Some(table) = sect5_rows(rows) else {
+        return;
+    };
+    let _ = write!(
+        h,
+        "<h2 id=\"sect5\">GPU shaders side by side (paper §5)</h2>\n<p>Frames per second (median) of the compute kernels and the hardware pipeline, each in brackets over <code>gpu-3dr</code>'s; the paper (ATI HD5870, 1920×1200, depth test off) measured 3DR 465 = homogeneous 465 &gt; 2DR 464 fps on 262,144 triangles and 2559 / 2558 / 2503 on 144. Triangles: what <code>gpu-3dr</code> set up. Adapter, driver and timing clock per row in <code>results.json</code> (<code>stats.gpu</code>) and below.</p>\n<table>"
+    );
+    for (k, line) in table.iter().enumerate() {
+        let cell = if k == 0 { "th" } else { "td" };
+        h.push_str("<tr>");
+        for (i, c) in line.iter().enumerate() {
+            let class = if i == 0 { " class=\"l\"" } else { "" };
+            let _ = write!(h, "<{cell}{class}>{}</{cell}>", escape(c.trim()));
+        }
+        h.push_str("</tr>\n");
+    }
+    h.push_str("</table>\n");
+}
+
 fn peers(h: &mut String, rows: &[Row]) {
     let peer = |r: &Row| r.algorithm.starts_with("peer-") || r.algorithm == "gpu-raster";
     if !rows.iter().any(peer) {

@@ -39,6 +39,10 @@ pub struct SweepFile {
     pub repeat: Option<u32>,
     pub threads: Option<Threads>,
     pub camera: Option<String>,
+    /// Depth test on, off or both (`[false, true]`): off is the paper's §5
+    /// GPU experiment, rendered by the GPU compute algorithms only.
+    #[serde(default)]
+    pub depth_test: Option<Vec<bool>>,
 }
 
 /// The sweep file's `threads`: one count or a list of counts, each measured.
@@ -107,6 +111,8 @@ pub struct Sweep {
     /// (empty: one run on all cores).
     pub threads: Vec<usize>,
     pub camera: Option<String>,
+    /// Depth test settings, each measured (on only, unless the file says).
+    pub depth_tests: Vec<bool>,
     /// Is any mode not `none` (then every scene gets an `ssaa:256` reference)?
     pub with_reference: bool,
     /// The file's text form (for results.json).
@@ -193,7 +199,13 @@ impl Sweep {
         }
         threads.sort_unstable();
         threads.dedup();
+        let depth_tests = match &file.depth_test {
+            None => vec![true],
+            Some(list) if list.is_empty() => return Err(bad("depth_test", "an empty list".into())),
+            Some(list) => list.clone(),
+        };
         Ok(Sweep {
+            depth_tests,
             scenes,
             entries,
             not_run,
@@ -209,20 +221,23 @@ impl Sweep {
         })
     }
 
-    /// Every cell in plan order: scene, viewport, mode, precision.
+    /// Every cell in plan order: scene, viewport, mode, precision, depth test.
     pub fn cells(&self) -> Vec<Cell> {
         let mut cells = Vec::new();
         for scene in &self.scenes {
             for viewport in &self.viewports {
                 for &aa in &self.aa {
                     for &precision in &self.precisions {
-                        cells.push(Cell {
-                            index: cells.len(),
-                            scene: scene.clone(),
-                            viewport: viewport.clone(),
-                            aa,
-                            precision,
-                        });
+                        for &depth_test in &self.depth_tests {
+                            cells.push(Cell {
+                                index: cells.len(),
+                                scene: scene.clone(),
+                                viewport: viewport.clone(),
+                                aa,
+                                precision,
+                                depth_test,
+                            });
+                        }
                     }
                 }
             }
@@ -240,6 +255,7 @@ pub struct Cell {
     pub viewport: ViewportChoice,
     pub aa: AaMode,
     pub precision: Precision,
+    pub depth_test: bool,
 }
 
 /// `I/N`: part `I` (0-based, as Kubernetes' `JOB_COMPLETION_INDEX`) of `N`.

@@ -5,6 +5,7 @@ mod agreement;
 mod conformance;
 mod effects;
 mod golden;
+mod gpu_compute;
 mod hard_cases;
 mod loaders;
 mod oracles;

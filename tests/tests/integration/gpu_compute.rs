@@ -1,0 +1,240 @@
+//! The GPU compute algorithms (paper §5) against their CPU families: on every
+//! built-in scene and camera, in both planar viewports, `gpu-3dr` and
+//! `gpu-3dr-binned` give the triangle ids of `3dr-brute`, `gpu-2dr` those of
+//! `2dr-brute` and `gpu-2dr-homogeneous` those of `2dr-homogeneous`, except
+//! at pixels the f64 explanation accounts for (a sample within 1e-3 pixel of
+//! an edge, at the near plane, or a depth tie); the counts are printed per
+//! scene. (Run on Mesa's lavapipe in CI.)
+
+use std::collections::{BTreeMap, HashMap};
+
+use continuum::{AaMode, AlgorithmId, RenderOutput, RenderRequest, render};
+use continuum_tests::matrix::{Cameras, Matrix, ViewportChoice};
+use continuum_tests::{DifferenceReport, builtin_scenes, explain_2d_3d, prepared};
+
+/// Each GPU kernel and the CPU algorithm it must agree with.
+const PAIRS: [(AlgorithmId, AlgorithmId); 4] = [
+    (AlgorithmId::Gpu2dr, AlgorithmId::TwoDBrute),
+    (AlgorithmId::Gpu2drHomogeneous, AlgorithmId::TwoDHomogeneous),
+    (AlgorithmId::Gpu3dr, AlgorithmId::ThreeDBrute),
+    (AlgorithmId::Gpu3drBinned, AlgorithmId::ThreeDBrute),
+];
+
+fn reference_of(gpu: AlgorithmId) -> Option<AlgorithmId> {
+    PAIRS.iter().find(|(g, _)| *g == gpu).map(|&(_, cpu)| cpu)
+}
+
+#[test]
+fn gpu_kernels_differ_from_their_cpu_family_only_where_explained() {
+    let mut algorithms = vec![
+        AlgorithmId::TwoDBrute,
+        AlgorithmId::TwoDHomogeneous,
+        AlgorithmId::ThreeDBrute,
+    ];
+    algorithms.extend(PAIRS.map(|(g, _)| g));
+    let mut references: HashMap<AlgorithmId, RenderOutput> = HashMap::new();
+    let mut per_scene: BTreeMap<(String, &'static str), DifferenceReport> = BTreeMap::new();
+    let mut compared = 0;
+    let rendered = Matrix {
+        cameras: Cameras::All,
+        viewports: vec![ViewportChoice::Own, ViewportChoice::Orthographic],
+        algorithms,
+        size: (160, 120),
+        ..Matrix::new()
+    }
+    .run(|cell| {
+        let algorithm = cell.request.algorithm;
+        let Some(cpu) = reference_of(algorithm) else {
+            references.insert(algorithm, cell.output.clone());
+            return;
+        };
+        let reference = &references[&cpu];
+        let r = explain_2d_3d(cell.prepared, cell.output, reference);
+        assert!(
+            r.unexplained.is_empty(),
+            "{} against {cpu}: unexplained differences (x, y, gpu id, cpu id): {:?}",
+            cell.label(),
+            &r.unexplained[..r.unexplained.len().min(10)]
+        );
+        assert!(
+            r.explained() * 1_000 <= r.covered.max(1),
+            "{}: {} differing pixels is more than 0.1% of {} covered",
+            cell.label(),
+            r.explained(),
+            r.covered
+        );
+        assert!(cell.output.stats.edge_evaluations > 0, "{}", cell.label());
+        let total = per_scene
+            .entry((cell.scene.to_string(), algorithm.as_str()))
+            .or_default();
+        total.covered += r.covered;
+        total.edge += r.edge;
+        total.near_plane += r.near_plane;
+        total.depth_tie += r.depth_tie;
+        compared += 1;
+    });
+    println!("GPU against CPU, per scene (160x120, every camera, own viewport and orthographic):");
+    for ((scene, algorithm), r) in &per_scene {
+        println!(
+            "  {scene:10} {algorithm:20} covered {:7}  differing {:4} (edge {}, near plane {}, depth tie {})",
+            r.covered,
+            r.explained(),
+            r.edge,
+            r.near_plane,
+            r.depth_tie
+        );
+    }
+    // Every scene and camera in two viewports; scenes with see-through
+    // materials are refused to the GPU (and so compared on opaque scenes only).
+    let opaque = builtin_scenes()
+        .iter()
+        .filter(|name| prepared(name).triangle_opacity.is_empty())
+        .count();
+    assert!(opaque >= 10, "only {opaque} opaque built-in scenes");
+    assert!(
+        compared >= opaque * 2 * 2 * PAIRS.len(),
+        "only {compared} compared"
+    );
+    assert!(rendered > compared, "no CPU reference rendered");
+}
+
+/// With anti-aliasing the kernels test the pattern's sample positions: the
+/// per-pixel sample digests match the CPU's but for a few pixels at edges.
+#[test]
+fn gpu_kernels_render_the_aa_patterns() {
+    let scene = prepared("teapots");
+    let camera = scene.scene.first_camera();
+    let mut checked = 0;
+    for aa in ["msaa:2", "msaa:4", "ssaa:4"] {
+        let aa = AaMode::parse(aa).expect("aa");
+        let run = |algorithm| {
+            let request = RenderRequest {
+                aa,
+                ..RenderRequest::new(algorithm, camera.clone(), 200, 150)
+            };
+            render(&scene, &request).unwrap_or_else(|e| panic!("{algorithm} {aa}: {e}"))
+        };
+        for (gpu, cpu) in PAIRS {
+            let (g, c) = (run(gpu), run(cpu));
+            let digests = |o: &RenderOutput| o.framebuffer.sample_digest.clone();
+            let differing = digests(&g)
+                .iter()
+                .zip(&digests(&c))
+                .filter(|(a, b)| a != b)
+                .count();
+            println!(
+                "{gpu} {aa}: {differing} of {} pixels differ from {cpu} in some sample",
+                200 * 150
+            );
+            assert!(!digests(&g).is_empty(), "{gpu} {aa}: no sample digests");
+            assert!(
+                differing * 500 <= 200 * 150,
+                "{gpu} {aa}: {differing} pixels differ"
+            );
+            assert_eq!(
+                g.stats.stored_samples_per_pixel,
+                c.stats.stored_samples_per_pixel
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 3 * PAIRS.len());
+}
+
+/// Counters and stage times mean what the CPU's do.
+#[test]
+fn gpu_kernels_report_setups_tests_tiles_and_device_times() {
+    let scene = prepared("bunny");
+    let camera = scene.scene.first_camera();
+    let run = |algorithm| {
+        render(
+            &scene,
+            &RenderRequest::new(algorithm, camera.clone(), 256, 192),
+        )
+        .unwrap_or_else(|e| panic!("{algorithm}: {e}"))
+    };
+    let cpu = run(AlgorithmId::ThreeDBrute);
+    for (gpu, _) in PAIRS {
+        let out = run(gpu);
+        let s = &out.stats;
+        let times = s.gpu.as_ref().expect("GPU stage times");
+        assert!(times.adapter.contains("llvmpipe") || !times.adapter.is_empty());
+        assert!(
+            times.clock == "timestamps" || times.clock == "wall",
+            "{gpu}: {}",
+            times.clock
+        );
+        assert!(times.raster > 0.0 && times.setup > 0.0, "{gpu}: {times:?}");
+        assert!(s.triangle_setups > 0 && s.edge_evaluations > 0, "{gpu}");
+        assert!(s.predicted_instructions > 0, "{gpu}");
+        // Every covered sample was counted once per triangle covering it.
+        assert_eq!(
+            s.coverage_histogram.zero, cpu.stats.coverage_histogram.zero,
+            "{gpu}"
+        );
+        let json = serde_json::to_value(s).expect("stats as JSON");
+        assert!(json["gpu"]["clock"].is_string(), "{gpu}: {json}");
+        if gpu == AlgorithmId::Gpu3drBinned {
+            assert!(s.counters.tiles_tested > 0, "{gpu}: no tile tests");
+            assert!(
+                s.counters.tiles_rejected + s.counters.tiles_accepted <= s.counters.tiles_tested
+            );
+        }
+    }
+}
+
+/// Bad requests name their field; nothing panics or hangs.
+#[test]
+fn gpu_kernels_refuse_what_they_cannot_render_by_field() {
+    let scene = prepared("box");
+    let camera = scene.scene.first_camera();
+    let field = |request: RenderRequest| {
+        render(&scene, &request)
+            .err()
+            .map(|e| e.field)
+            .unwrap_or("rendered")
+    };
+    let mut refused = 0;
+    for (gpu, _) in PAIRS {
+        let base = RenderRequest::new(gpu, camera.clone(), 32, 24);
+        for aa in ["csaa:8x2", "ssaa:16", "msaa:8"] {
+            let r = RenderRequest {
+                aa: AaMode::parse(aa).expect("aa"),
+                ..base.clone()
+            };
+            assert_eq!(field(r), "aa", "{gpu} {aa}");
+            refused += 1;
+        }
+        let r = RenderRequest {
+            oracles: continuum::Oracles::parse("early_z=off").expect("oracles"),
+            ..base.clone()
+        };
+        assert_eq!(field(r), "oracles", "{gpu}");
+        let mut parabolic = base.clone();
+        parabolic.camera.viewport = continuum::Viewport::Parabolic;
+        let e = render(&scene, &parabolic).expect_err("parabolic");
+        assert_eq!(e.field, "viewport", "{gpu}");
+        assert!(e.message.contains("perspective and orthographic"), "{e}");
+        // Larger than the adapter's largest storage buffer (lavapipe: 128 MiB;
+        // 4 samples of 4 bytes for 4096x2100 pixels is 131 MiB).
+        let r = RenderRequest {
+            aa: AaMode::Ssaa(4),
+            ..RenderRequest::new(gpu, camera.clone(), 4096, 2100)
+        };
+        assert_eq!(field(r), "size", "{gpu}");
+        refused += 3;
+    }
+    // See-through materials: the GPU draws opaque surfaces only.
+    let glass = builtin_scenes()
+        .into_iter()
+        .find(|name| !prepared(name).triangle_opacity.is_empty())
+        .expect("a built-in scene with see-through materials");
+    let glass = prepared(&glass);
+    let e = render(
+        &glass,
+        &RenderRequest::new(AlgorithmId::Gpu3dr, glass.scene.first_camera(), 32, 24),
+    )
+    .expect_err("see-through");
+    assert_eq!(e.field, "algorithm");
+    assert_eq!(refused, PAIRS.len() * 6);
+}
