@@ -239,6 +239,18 @@ fn pixel_geometry_orthographic(
     }
 }
 
+/// The f64 view-axis depths of triangles `a` and `b` at the centre of
+/// pixel `(x, y)` of `view`.
+pub fn depths_at(
+    scene: &PreparedScene,
+    view: &continuum::View,
+    (x, y): (u32, u32),
+    [a, b]: [u32; 2],
+) -> [f64; 2] {
+    let (xc, yc) = (f64::from(x) + 0.5, f64::from(y) + 0.5);
+    [a, b].map(|id| pixel_geometry(scene, view, id, xc, yc).w)
+}
+
 /// Explains, in f64, every pixel where the 2D and 3D renders pick different
 /// triangles (see [`Explanation`]).
 pub fn explain_2d_3d(

@@ -395,7 +395,7 @@ impl Gpu {
         let limits = self.device.limits();
         let max = limits
             .max_buffer_size
-            .min(u64::from(limits.max_storage_buffer_binding_size));
+            .min(limits.max_storage_buffer_binding_size);
         if size > max {
             return Err(GpuError::BufferTooLarge {
                 what: label.to_string(),
@@ -479,14 +479,7 @@ impl Gpu {
         (atomics, depth_test): (GpuAtomics, bool),
         clip: &dyn Fn(&[u32]) -> Vec<TriWords>,
     ) -> Result<ComputeSamples, GpuError> {
-        let (width, height) = (view.width, view.height);
-        if width > self.max_dimension || height > self.max_dimension {
-            return Err(GpuError::TooLarge {
-                width,
-                height,
-                max: self.max_dimension,
-            });
-        }
+        self.fits(view)?;
         let _one_at_a_time = self.lock.lock().unwrap_or_else(|e| e.into_inner());
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let result = self.compute_scoped(mesh, kind, view, pattern, (atomics, depth_test), clip);
@@ -631,31 +624,30 @@ impl Gpu {
         // 3. Binning (sort-middle only): count, prefix sum, then the lists.
         let mut encoder = self.device.create_command_encoder(&Default::default());
         if module == Module::Binned {
-            let bind = dispatch.bind(&shared, &tris, &big, &own, [records, 0, 0, 0]);
-            dispatch.pass(&mut encoder, 1, "bin", &bind, groups_for(records));
-            dispatch.big_passes(
-                &mut encoder,
-                1,
-                "bin_big",
-                &shared,
-                (&tris, &big, &own),
-                (big_count, chunks, 0),
-            );
+            let bins = |dispatch: &mut Dispatcher,
+                        encoder: &mut wgpu::CommandEncoder,
+                        own: &[wgpu::Buffer],
+                        pass| {
+                let bind = dispatch.bind(&shared, &tris, &big, own, [records, pass, 0, 0]);
+                dispatch.pass(encoder, 1, "bin", &bind, groups_for(records));
+                let buffers = (&tris, &big, own);
+                dispatch.big_passes(
+                    encoder,
+                    1,
+                    "bin_big",
+                    &shared,
+                    buffers,
+                    (big_count, chunks, pass),
+                );
+                bind
+            };
+            let bind = bins(&mut dispatch, &mut encoder, &own, 0);
             dispatch.pass(&mut encoder, 1, "scan", &bind, (1, 1));
             dispatch.submit(1, encoder)?;
             let count = self.counters(&counters)?;
             own[3] = self.zeroed("tile list", u64::from(count[5]) * 4, "size")?;
             encoder = self.device.create_command_encoder(&Default::default());
-            let bind = dispatch.bind(&shared, &tris, &big, &own, [records, 1, 0, 0]);
-            dispatch.pass(&mut encoder, 1, "bin", &bind, groups_for(records));
-            dispatch.big_passes(
-                &mut encoder,
-                1,
-                "bin_big",
-                &shared,
-                (&tris, &big, &own),
-                (big_count, chunks, 1),
-            );
+            bins(&mut dispatch, &mut encoder, &own, 1);
             // 4. Raster: a workgroup per tile, the lists in segments.
             for segment in 0..count[7].div_ceil(SEGMENT).max(1) {
                 let bind = dispatch.bind(&shared, &tris, &big, &own, [records, 0, 0, segment]);

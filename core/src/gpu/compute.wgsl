@@ -213,6 +213,26 @@ fn camera_box(c: array<vec3<f32>, 3>) -> vec2<u32> {
     return pixel_box(lo, hi, margin);
 }
 
+// Vertices beyond 2³² make the setup's products overflow: scaled by a power
+// of two so that the largest coordinate is about 1 (`edge3d::scaled`;
+// exact, no sign changes). Returns the factor that undoes it.
+fn scale_down(c: ptr<function, array<vec3<f32>, 3>>) -> f32 {
+    let m = max(max(max_abs((*c)[0]), max_abs((*c)[1])), max_abs((*c)[2]));
+    if !(m > 4294967296.0 && finite(m)) {
+        return 1.0;
+    }
+    let k = i32(ceil(log2(m)));
+    for (var i = 0u; i < 3u; i++) {
+        (*c)[i] = ldexp((*c)[i], vec3<i32>(-k));
+    }
+    return ldexp(1.0, k);
+}
+
+fn max_abs(v: vec3<f32>) -> f32 {
+    let a = abs(v);
+    return max(max(a.x, a.y), a.z);
+}
+
 fn thread_index(wg: vec3<u32>, groups: vec3<u32>, local: u32) -> u32 {
     return (wg.y * groups.x + wg.x) * 64u + local;
 }
@@ -303,6 +323,8 @@ fn setup_3d(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) group
     }
     let w = vec3<f32>(dot3(c[0], P.forward.xyz), dot3(c[1], P.forward.xyz), dot3(c[2], P.forward.xyz));
     let pbox = camera_box(cam);
+    let scale = scale_down(&c);
+    let down = 1.0 / scale;
     let e1 = c[1] - c[0];
     let e2 = c[2] - c[0];
     let normal = cross3(e1, e2);
@@ -324,7 +346,7 @@ fn setup_3d(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) group
             b[i] = e.y;
             cc[i] = e.z;
         }
-        set_up(k, linear_tri(l.id, a, b, cc, along(normal * s), vec3<f32>(abs(d), 0.0, 0.0), w, pbox));
+        set_up(k, linear_tri(l.id, a, b, cc, along(normal * s), vec3<f32>(abs(d) * scale, 0.0, 0.0), w, pbox));
     } else {
         let dp = P.forward.xyz;
         let facing = dot3(normal, dp);
@@ -338,12 +360,12 @@ fn setup_3d(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) group
             let q = c[(i + 2u) % 3u];
             let m = (p + q) * 0.5;
             let n = cross3(dp, p - q) * s;
-            a[i] = dot3(n, m - P.o0.xyz);
-            b[i] = -dot3(n, P.ox.xyz);
-            cc[i] = -dot3(n, P.oy.xyz);
+            a[i] = dot3(n, m - P.o0.xyz * down);
+            b[i] = -dot3(n, P.ox.xyz * down);
+            cc[i] = -dot3(n, P.oy.xyz * down);
         }
         let ns = normal * s;
-        let volume = vec3<f32>(dot3(ns, c[0] - P.o0.xyz), -dot3(ns, P.ox.xyz), -dot3(ns, P.oy.xyz));
+        let volume = vec3<f32>(dot3(ns, c[0] - P.o0.xyz * down), -dot3(ns, P.ox.xyz * down), -dot3(ns, P.oy.xyz * down)) * scale;
         set_up(k, linear_tri(l.id, a, b, cc, vec3<f32>(abs(facing), 0.0, 0.0), volume, w, pbox));
     }
 }
@@ -369,6 +391,7 @@ fn setup_homogeneous(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgrou
         w[i] = c.z;
     }
     let pbox = camera_box(cam);
+    let scale = scale_down(&h);
     var rows: array<vec3<f32>, 3>;
     for (var i = 0u; i < 3u; i++) {
         let p = h[(i + 1u) % 3u];
@@ -391,7 +414,7 @@ fn setup_homogeneous(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgrou
         c[i] = rows[i].y * s;
     }
     let nd = vec3<f32>(normal.z * s, normal.x * s, normal.y * s);
-    var volume = vec3<f32>(abs(det), 0.0, 0.0);
+    var volume = vec3<f32>(abs(det) * scale, 0.0, 0.0);
     if P.mode.x == 1u {
         let r = rows[0] * w[0] + rows[1] * w[1] + rows[2] * w[2];
         volume = vec3<f32>(r.z * s, r.x * s, r.y * s);

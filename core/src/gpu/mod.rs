@@ -415,7 +415,7 @@ impl Gpu {
             b
         };
         let mesh = &scene.scene.mesh;
-        let storage_max = u64::from(self.device.limits().max_storage_buffer_binding_size);
+        let storage_max = self.device.limits().max_storage_buffer_binding_size;
         if mesh.positions.len() as u64 * 12 > storage_max
             || mesh.triangles.len() as u64 * 12 > storage_max
         {
@@ -445,9 +445,8 @@ impl Gpu {
         })
     }
 
-    /// Renders `view` of `mesh`: per pixel the triangle id (`u32::MAX` for
-    /// none), the view-axis distance (`+∞` for none) and the fragment count.
-    pub(crate) fn draw(&self, mesh: &GpuMesh, view: &View, far: f32) -> Result<Samples, GpuError> {
+    /// Whether the view fits the adapter's largest image.
+    fn fits(&self, view: &View) -> Result<(), GpuError> {
         let (width, height) = (view.width, view.height);
         if width > self.max_dimension || height > self.max_dimension {
             return Err(GpuError::TooLarge {
@@ -456,6 +455,14 @@ impl Gpu {
                 max: self.max_dimension,
             });
         }
+        Ok(())
+    }
+
+    /// Renders `view` of `mesh`: per pixel the triangle id (`u32::MAX` for
+    /// none), the view-axis distance (`+∞` for none) and the fragment count.
+    pub(crate) fn draw(&self, mesh: &GpuMesh, view: &View, far: f32) -> Result<Samples, GpuError> {
+        self.fits(view)?;
+        let (width, height) = (view.width, view.height);
         let _one_at_a_time = self.lock.lock().unwrap_or_else(|e| e.into_inner());
         let device = &self.device;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);

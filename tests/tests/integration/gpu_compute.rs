@@ -3,14 +3,15 @@
 //! `gpu-3dr-binned` give the triangle ids of `3dr-brute`, `gpu-2dr` those of
 //! `2dr-brute` and `gpu-2dr-homogeneous` those of `2dr-homogeneous`, except
 //! at pixels the f64 explanation accounts for (a sample within 1e-3 pixel of
-//! an edge, at the near plane, or a depth tie); the counts are printed per
-//! scene. (Run on Mesa's lavapipe in CI.)
+//! an edge, at the near plane, or a depth tie — within 1e-5, or 1e-4 for the
+//! GPU's own rounding); the counts are printed per scene. (Run on Mesa's
+//! lavapipe in CI.)
 
 use std::collections::{BTreeMap, HashMap};
 
 use continuum::{AaMode, AlgorithmId, RenderOutput, RenderRequest, render};
 use continuum_tests::matrix::{Cameras, Matrix, ViewportChoice};
-use continuum_tests::{DifferenceReport, builtin_scenes, explain_2d_3d, prepared};
+use continuum_tests::{DifferenceReport, builtin_scenes, depths_at, explain_2d_3d, prepared};
 
 /// Each GPU kernel and the CPU algorithm it must agree with.
 const PAIRS: [(AlgorithmId, AlgorithmId); 4] = [
@@ -35,6 +36,7 @@ fn gpu_kernels_differ_from_their_cpu_family_only_where_explained() {
     let mut references: HashMap<AlgorithmId, RenderOutput> = HashMap::new();
     let mut per_scene: BTreeMap<(String, &'static str), DifferenceReport> = BTreeMap::new();
     let mut compared = 0;
+    let mut near_ties = 0;
     let rendered = Matrix {
         cameras: Cameras::All,
         viewports: vec![ViewportChoice::Own, ViewportChoice::Orthographic],
@@ -49,7 +51,19 @@ fn gpu_kernels_differ_from_their_cpu_family_only_where_explained() {
             return;
         };
         let reference = &references[&cpu];
-        let r = explain_2d_3d(cell.prepared, cell.output, reference);
+        let mut r = explain_2d_3d(cell.prepared, cell.output, reference);
+        // Near-ties: the GPU's f32 (its driver may fuse multiplies and adds)
+        // and the CPU's round a depth differently; between surfaces within
+        // 1e-4 of each other in depth (f64) either may win.
+        let view = &reference.view;
+        r.unexplained.retain(|&(x, y, a, b)| {
+            let near_tie = a != continuum::BACKGROUND && b != continuum::BACKGROUND && {
+                let [wa, wb] = depths_at(cell.prepared, view, (x, y), [a, b]);
+                (wa - wb).abs() <= 1e-4 * wa.abs().max(wb.abs())
+            };
+            near_ties += usize::from(near_tie);
+            !near_tie
+        });
         assert!(
             r.unexplained.is_empty(),
             "{} against {cpu}: unexplained differences (x, y, gpu id, cpu id): {:?}",
@@ -73,7 +87,9 @@ fn gpu_kernels_differ_from_their_cpu_family_only_where_explained() {
         total.depth_tie += r.depth_tie;
         compared += 1;
     });
-    println!("GPU against CPU, per scene (160x120, every camera, own viewport and orthographic):");
+    println!(
+        "GPU against CPU, per scene (160x120, every camera, own viewport and orthographic); {near_ties} depth near-ties (within 1e-4) in all:"
+    );
     for ((scene, algorithm), r) in &per_scene {
         println!(
             "  {scene:10} {algorithm:20} covered {:7}  differing {:4} (edge {}, near plane {}, depth tie {})",
@@ -96,6 +112,10 @@ fn gpu_kernels_differ_from_their_cpu_family_only_where_explained() {
         "only {compared} compared"
     );
     assert!(rendered > compared, "no CPU reference rendered");
+    assert!(
+        near_ties <= compared,
+        "{near_ties} depth near-ties in {compared} views"
+    );
 }
 
 /// With anti-aliasing the kernels test the pattern's sample positions: the
