@@ -589,7 +589,8 @@ pub struct CaseSummary {
     pub name: String,
     pub description: String,
     pub triangles: usize,
-    /// The smallest offset at which any f32 render breaks an invariant.
+    /// The smallest offset at which any of continuum's own f32 renders on the
+    /// CPU breaks an invariant.
     pub f32_first_violation: Option<f64>,
     /// Do all f64 renders hold at every offset?
     pub f64_holds: bool,
@@ -624,7 +625,11 @@ pub fn run_suite(cases: &[HardCase]) -> Result<SuiteReport, SceneError> {
             name: case.name.clone(),
             description: case.file.description.clone(),
             triangles: case.scene(0.0)?.mesh.triangle_count(),
-            f32_first_violation: first(&|c| c.precision == Precision::F32 && !snapped(c)),
+            // continuum's own f32 on the CPU; the GPU's kernels (f32 without
+            // an exact fallback) are held to their cases' documented limits.
+            f32_first_violation: first(&|c| {
+                c.precision == Precision::F32 && !snapped(c) && c.algorithm.family() != Family::Gpu
+            }),
             f64_holds: first(&|c| c.precision == Precision::F64).is_none(),
             snapped_first_violation: first(&snapped),
         });

@@ -258,6 +258,10 @@ pub(crate) struct TileContext<'a> {
     /// Record each tile's [`Trace`].
     pub trace: bool,
     /// Keep the nearest sample (off: the GPU compute kernels' §5 mode).
+    #[cfg_attr(
+        not(feature = "gpu"),
+        expect(dead_code, reason = "read by the GPU compute kernels only")
+    )]
     pub depth_test: bool,
 }
 

@@ -109,6 +109,7 @@ fn setup_pieces<T: Send>(
 /// The set-up pieces of the triangles `ids` after clipping (near plane and
 /// guard band, in f64), each with its pixels and its triangle's id: what
 /// [`setup_2d`] makes of the triangles it clips.
+#[cfg(feature = "gpu")]
 pub(crate) fn clipped_pieces(
     scene: &PreparedScene,
     view: &View,

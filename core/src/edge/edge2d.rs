@@ -115,6 +115,7 @@ impl Triangle2D {
     /// 2D layout): rows 0..2 `(lo, Δ)` per edge, row 3 `(signs, q0)`, row 4
     /// `(q1, q2, w_min, w_max)`; and the flags (tie ownership per edge, 2D,
     /// affine).
+    #[cfg(feature = "gpu")]
     pub(crate) fn gpu_rows(&self) -> ([[f32; 4]; 5], u32) {
         let edge = |i: usize| {
             [
