@@ -69,8 +69,11 @@ pub(crate) fn render_compute(
         .map_err(failed)?;
     let times = samples.times.clone();
     stats.triangle_setups = samples.setups;
-    stats.time_ms.setup = upload_ms + times.setup + times.binning;
-    stats.time_ms.coverage = times.raster;
+    // The frame's stages in host time, so that they add up to the total
+    // (the device's own per pass are in `stats.gpu`).
+    let [setup, binning, raster] = samples.wall;
+    stats.time_ms.setup = upload_ms + setup + binning;
+    stats.time_ms.coverage = raster;
     stats.time_ms.store += times.readback;
     stats.gpu = Some(times);
 

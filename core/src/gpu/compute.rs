@@ -53,6 +53,9 @@ pub(crate) struct ComputeSamples {
     pub clipped: u64,
     /// Binned: tile tests, tiles accepted whole, tiles rejected.
     pub tiles: [u64; 3],
+    /// Host milliseconds from submit to a finished device poll: setup
+    /// (with the CPU's clipping), binning, raster.
+    pub wall: [f64; 3],
     pub times: GpuTimes,
 }
 
@@ -744,6 +747,7 @@ impl Gpu {
         ) = (ids, depth, writes, evals);
         let readback = start.elapsed().as_secs_f64() * 1e3;
         let wall = dispatch.wall;
+        out.wall = wall;
         let mut times = GpuTimes {
             adapter: self.adapter.clone(),
             clock: "wall".into(),
