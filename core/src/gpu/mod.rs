@@ -36,7 +36,7 @@ pub(crate) use compute::{ComputeSamples, TriWords};
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum GpuError {
     #[error(
-        "no Vulkan device: gpu-raster needs a GPU or Mesa's lavapipe (Debian: apt-get install mesa-vulkan-drivers libvulkan1): {0}"
+        "no Vulkan device: the GPU algorithms need a GPU or Mesa's lavapipe (Debian: apt-get install mesa-vulkan-drivers libvulkan1): {0}"
     )]
     NoDevice(String),
     #[error("{width}x{height} exceeds the GPU's largest render target of {max}x{max}")]
@@ -71,8 +71,8 @@ impl GpuError {
 /// the first render (`--adapter`); `CONTINUUM_ADAPTER` otherwise.
 static ADAPTER_CHOICE: OnceLock<String> = OnceLock::new();
 
-/// Forces the compute kernels' 32-bit two-pass visibility (`--gpu-atomics
-/// two-pass`; `CONTINUUM_GPU_ATOMICS=two-pass`).
+/// Forces the compute kernels' 32-bit two-pass visibility
+/// (`continuum::force_gpu_two_pass`; `CONTINUUM_GPU_ATOMICS=two-pass`).
 static FORCE_TWO_PASS: AtomicBool = AtomicBool::new(false);
 
 /// Chooses the adapter by name; only the first choice, made before the GPU
