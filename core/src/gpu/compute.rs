@@ -421,6 +421,11 @@ impl Gpu {
     /// in the meantime.
     fn finish(&self, encoder: wgpu::CommandEncoder) -> Result<(), GpuError> {
         self.queue.submit([encoder.finish()]);
+        self.wait()
+    }
+
+    /// Waits for the device and reports an error raised in the meantime.
+    fn wait(&self) -> Result<(), GpuError> {
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map_err(|e| GpuError::Failed(e.to_string()))?;
@@ -451,12 +456,7 @@ impl Gpu {
         for s in &staging {
             s.map_async(wgpu::MapMode::Read, .., |_| {});
         }
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| GpuError::Failed(e.to_string()))?;
-        if let Some(e) = UNCAPTURED.lock().unwrap_or_else(|p| p.into_inner()).take() {
-            return Err(GpuError::Failed(e));
-        }
+        self.wait()?;
         staging
             .iter()
             .zip(buffers)
@@ -695,10 +695,10 @@ impl Gpu {
                     .chunks_exact(8)
                     .map(|c| {
                         let key = !u64::from_le_bytes(c.try_into().expect("8 bytes"));
+                        // An empty sample's key is all ones: its id reads as none
+                        // either way round.
                         let (hi, lo) = ((key >> 32) as u32, key as u32);
-                        if key == u64::MAX {
-                            visible(u32::MAX, 0)
-                        } else if depth_test {
+                        if depth_test {
                             visible(lo, hi)
                         } else {
                             visible(hi, lo)
