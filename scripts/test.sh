@@ -49,26 +49,32 @@ if [ -z "${XDG_RUNTIME_DIR:-}" ]; then
 fi
 chmod 0700 "$XDG_RUNTIME_DIR" 2>/dev/null || true
 
-# 3. An X server for the viewer's real window when there is no display.
+# 3. An X server for the viewer's real window when there is no display. Xvfb picks a free display
+# itself and writes its number to fd 3 only once it accepts clients (-displayfd), so nothing here
+# races its start.
 xvfb_pid=""
 cleanup() { [ -n "$xvfb_pid" ] && kill "$xvfb_pid" 2>/dev/null || true; }
 trap cleanup EXIT
 if [ -z "${DISPLAY:-}" ]; then
-    for n in $(seq 90 130); do
-        [ -e "/tmp/.X11-unix/X$n" ] || [ -e "/tmp/.X$n-lock" ] || break
-    done
-    Xvfb ":$n" -screen 0 1280x800x24 -nolisten tcp >/dev/null 2>&1 &
+    displayfile="$(mktemp)"
+    Xvfb -displayfd 3 -screen 0 1280x800x24 -nolisten tcp 3>"$displayfile" >/dev/null 2>&1 &
     xvfb_pid=$!
-    for _ in $(seq 100); do [ -e "/tmp/.X11-unix/X$n" ] && break; sleep 0.1; done
-    [ -e "/tmp/.X11-unix/X$n" ] || { echo "error: Xvfb did not start on :$n" >&2; exit 1; }
+    for _ in $(seq 200); do [ -s "$displayfile" ] && break; sleep 0.1; done
+    n="$(tr -dc 0-9 <"$displayfile")"
+    rm -f "$displayfile"
+    [ -n "$n" ] || { echo "error: Xvfb did not start" >&2; exit 1; }
     export DISPLAY=":$n"
 fi
 
 # 4. Vulkan must be there: the GPU tests fail loudly without it, and this says why first.
-# (Read whole before grep: `grep -q` quitting early would SIGPIPE vulkaninfo and fail the pipe.)
-vulkan="$(vulkaninfo --summary 2>/dev/null || true)"
-grep -qE "deviceName" <<<"$vulkan" \
-    || { echo "error: no Vulkan device (Debian: mesa-vulkan-drivers libvulkan1)" >&2; exit 1; }
+# vulkaninfo runs without DISPLAY (only devices are asked for, not window surfaces) and its output
+# is read whole before grep (`grep -q` quitting early would SIGPIPE it and fail the pipe).
+vulkan="$(env -u DISPLAY vulkaninfo --summary 2>&1 || true)"
+if ! grep -qE "deviceName" <<<"$vulkan"; then
+    echo "error: no Vulkan device (Debian: mesa-vulkan-drivers libvulkan1); vulkaninfo said:" >&2
+    tail -n 20 <<<"$vulkan" >&2
+    exit 1
+fi
 
 # 5. The tests.
 cargo test --workspace "$@"
