@@ -3,12 +3,20 @@
 # viewport, anti-aliasing family and precision, as one sorted JSON line per render:
 # run it before and after a refactor or a speed change and diff the two outputs.
 #   scripts/hash-matrix.sh [CONTINUUM_BINARY] > hashes.jsonl
-# (default binary: target/release/continuum; about a minute on two cores).
+# (default binary: target/release/continuum). Every algorithm by default, the GPU's on
+# lavapipe taking far the longest; ALGORITHMS=cpu keeps to the CPU's (about a minute on two
+# cores), or name them: ALGORITHMS=3dr-full,raycast.
 set -euo pipefail
 bin="${1:-${CARGO_TARGET_DIR:-target}/release/continuum}"
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
-"$bin" compare --size 64x48 --repeat 1 --threads 2 \
+algorithms=()
+case "${ALGORITHMS:-}" in
+    "") ;;
+    cpu) algorithms=(--algorithms 2dr-brute,2dr-bin,2dr-scanline,2dr-homogeneous,3dr-brute,3dr-bin,3dr-frustum-cull,3dr-frustum-split,3dr-full,raycast) ;;
+    *) algorithms=(--algorithms "$ALGORITHMS") ;;
+esac
+"$bin" compare "${algorithms[@]}" --size 64x48 --repeat 1 --threads 2 \
     --viewports camera,orthographic,parabolic,latlong \
     --aa none,msaa:4,csaa:8x2,ssaa:4 --precision f32,f64,fixed \
     --out "$out" >/dev/null

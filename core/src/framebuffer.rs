@@ -4,6 +4,7 @@
 
 use crate::aa::SamplePattern;
 use crate::ground::PixelRect;
+use crate::hiz::Hiz;
 use crate::prepared::is_see_through;
 use crate::stats::{CoverageHistogram, Hashes};
 
@@ -291,13 +292,9 @@ pub struct Fragment {
 /// Pixels of a row the coverage kernel handles at once (its CSAA scratch).
 pub(crate) const SCRATCH_PIXELS: usize = 64;
 
-/// Side of a hierarchical w-buffer cell in pixels.
-pub const HIZ_CELL: u32 = 8;
-
 /// A rectangle of the framebuffer rendered by one worker: the visibility buffers
 /// of pixels `x0..x1 × y0..y1` for every stored sample of the pattern, plus a
-/// hierarchical w-buffer holding, per [`HIZ_CELL`]² cell, the farthest depth
-/// stored in it over all samples (paper §5 "early-z").
+/// hierarchical w-buffer over them ([`Hiz`], paper §5 "early-z").
 ///
 /// Sample buffers are layer-major: stored sample `s` of pixel `i` is at
 /// `s · pixels + i`, so the samples of one position along a row are contiguous.
@@ -328,8 +325,8 @@ pub struct TileBuffer<'p> {
     /// and the depths at their stored positions (empty otherwise).
     pub(crate) scratch_masks: Vec<u32>,
     pub(crate) scratch_depths: Vec<f32>,
-    /// Farthest depth per cell (`+∞` while any sample of it is empty).
-    pub hiz: Vec<f32>,
+    /// The hierarchical w-buffer over [`TileBuffer::depth`].
+    pub(crate) hiz: Hiz,
     /// Opacity per triangle id ([`crate::PreparedScene::triangle_opacity`]);
     /// empty when every triangle is opaque.
     pub opacity: &'p [f32],
@@ -337,7 +334,6 @@ pub struct TileBuffer<'p> {
     pub fragments: Vec<Fragment>,
     /// What the algorithm did in this tile, when the render records it.
     pub trace: Option<crate::trace::Trace>,
-    hiz_columns: u32,
     /// Has a stored depth decreased since the last [`TileBuffer::update_hiz`]?
     depth_lowered: bool,
 }
@@ -352,8 +348,6 @@ impl<'p> TileBuffer<'p> {
     ) -> TileBuffer<'p> {
         let pixels = ((x1 - x0) * (y1 - y0)) as usize;
         let samples = pixels * pattern.stored;
-        let hiz_columns = (x1 - x0).div_ceil(HIZ_CELL);
-        let hiz_rows = (y1 - y0).div_ceil(HIZ_CELL);
         TileBuffer {
             x0,
             y0,
@@ -385,11 +379,10 @@ impl<'p> TileBuffer<'p> {
             } else {
                 Vec::new()
             },
-            hiz: vec![f32::INFINITY; (hiz_columns * hiz_rows) as usize],
+            hiz: Hiz::new(PixelRect { x0, y0, x1, y1 }),
             opacity,
             fragments: Vec::new(),
             trace: None,
-            hiz_columns,
             depth_lowered: false,
         }
     }
@@ -422,10 +415,7 @@ impl<'p> TileBuffer<'p> {
             refill(&mut self.masks, samples, 0);
             refill(&mut self.covered_any, pixels, 0);
         }
-        self.hiz_columns = (x1 - x0).div_ceil(HIZ_CELL);
-        let cells = (self.hiz_columns * (y1 - y0).div_ceil(HIZ_CELL)) as usize;
-        self.hiz.clear();
-        self.hiz.resize(cells, f32::INFINITY);
+        self.hiz.reset(PixelRect { x0, y0, x1, y1 });
         self.fragments.clear();
         self.depth_lowered = false;
     }
@@ -478,56 +468,19 @@ impl<'p> TileBuffer<'p> {
         }
     }
 
-    /// The hierarchical w-buffer cells (columns, rows; half-open) that the
-    /// pixels of the non-empty `r` (screen coordinates, inside the tile) touch.
+    /// The farthest stored depth over the hierarchical w-buffer's cells that
+    /// the pixels of `r` touch (`+∞` while any of their samples is empty).
     #[inline]
-    fn hiz_cells(&self, r: PixelRect) -> (std::ops::Range<u32>, std::ops::Range<u32>) {
-        let cell = |v: u32, origin: u32| (v - origin) / HIZ_CELL;
-        (
-            cell(r.x0, self.x0)..cell(r.x1 - 1, self.x0) + 1,
-            cell(r.y0, self.y0)..cell(r.y1 - 1, self.y0) + 1,
-        )
-    }
-
-    /// The farthest stored depth over the cells that the pixels of `r` touch.
     pub fn hiz_max(&self, r: PixelRect) -> f32 {
-        let (columns, rows) = self.hiz_cells(r);
-        let mut max = f32::NEG_INFINITY;
-        for cy in rows {
-            for cx in columns.clone() {
-                max = max.max(self.hiz[(cy * self.hiz_columns + cx) as usize]);
-            }
-        }
-        max
+        self.hiz.farthest(r)
     }
 
-    /// Recomputes the cells that the pixels of `r` touch, if a depth has
-    /// decreased since the last update (every write between two updates falls
-    /// inside the rectangle the second one names).
+    /// Brings the hierarchical w-buffer's cells that the pixels of `r` touch up
+    /// to date, if a depth has decreased since the last update (every write
+    /// between two updates falls inside the rectangle the second one names).
     pub fn update_hiz(&mut self, r: PixelRect) {
-        if !std::mem::take(&mut self.depth_lowered) {
-            return;
-        }
-        let (columns, rows) = self.hiz_cells(r);
-        for cy in rows {
-            for cx in columns.clone() {
-                let px0 = self.x0 + cx * HIZ_CELL;
-                let py0 = self.y0 + cy * HIZ_CELL;
-                let px1 = (px0 + HIZ_CELL).min(self.x1);
-                let mut max = f32::NEG_INFINITY;
-                // Stop at the first empty sample: nothing is farther.
-                'scan: for layer in self.depth.chunks_exact(self.pixels) {
-                    for y in py0..(py0 + HIZ_CELL).min(self.y1) {
-                        let i = self.index(px0, y);
-                        let row = &layer[i..i + (px1 - px0) as usize];
-                        max = row.iter().copied().fold(max, f32::max);
-                        if max == f32::INFINITY {
-                            break 'scan;
-                        }
-                    }
-                }
-                self.hiz[(cy * self.hiz_columns + cx) as usize] = max;
-            }
+        if std::mem::take(&mut self.depth_lowered) {
+            self.hiz.update(r, &self.depth, self.pixels);
         }
     }
 }

@@ -49,6 +49,7 @@ mod prepared;
 // Floor 6 — frame buffers, statistics, images of them, screen boxes.
 mod stats;
 mod trace;
+mod hiz;
 mod framebuffer;
 pub mod maps;
 pub mod metrics;

@@ -155,6 +155,43 @@ impl ImageMap {
         ImagePoint::Projected { x, y, pad }
     }
 
+    /// A conservative image box of the axis-aligned box `lo..hi` (world
+    /// space): interval arithmetic on `G` over the box, widened by a bound on
+    /// f32 rounding as in [`ImageMap::point`] (doubled), so it holds the image
+    /// point of every vertex inside, and so the screen box of every triangle
+    /// with its vertices inside. `None` unless the box lies certainly beyond
+    /// `near_bound` (and in front of the eye).
+    #[inline]
+    fn box_bounds(&self, lo: Vec3, hi: Vec3, eye: Vec3) -> Option<ImageBox> {
+        let o = eye + self.origin.unwrap_or(Vec3::ZERO);
+        let (mid, half) = ((lo + hi) * 0.5 - o, (hi - lo) * 0.5);
+        // Bounds every vertex's `p − eye` (and `− o0`) and their roundings.
+        let magnitude = mid.abs() + half + eye.abs() + o.abs();
+        let [ra, rb, rc] = self.rows;
+        let reach = half + magnitude * (32.0 * EPS);
+        let [ea, eb, ec] = self.rows_abs.map(|r| r.dot(reach));
+        let (a, b, c) = (ra.dot(mid), rb.dot(mid), rc.dot(mid));
+        let (clo, chi) = (c - ec, c + ec);
+        if !(clo >= self.near_bound && clo > 0.0) {
+            return None;
+        }
+        let mut image_box = ImageBox::EMPTY;
+        if self.origin.is_some() {
+            image_box.grow(a - ea, b - eb, 0.0);
+            image_box.grow(a + ea, b + eb, 0.0);
+        } else {
+            // A quotient's extremes lie at its intervals' ends (c > 0); each
+            // product with a reciprocal is off by under 3ε relative.
+            for inverse in [1.0 / clo, 1.0 / chi] {
+                for (x, y) in [(a - ea, b - eb), (a + ea, b + eb)] {
+                    image_box.grow(x * inverse, y * inverse, 0.0);
+                }
+            }
+        }
+        image_box.pad = 8.0 * EPS * image_box.magnitude() + 1.0 / 1024.0;
+        image_box.magnitude().is_finite().then_some(image_box)
+    }
+
     /// The box of the triangle `p` with vertex image points `points`: theirs
     /// when all three are projected; `None` when all three are nearer than
     /// the bound (so is every point of the triangle, which has no sample at
@@ -267,6 +304,26 @@ impl ScreenBoxes {
     }
 }
 
+impl ScreenBoxes {
+    /// The pixels with a sample in a conservative screen box of the
+    /// axis-aligned box `lo..hi` ([`ImageMap::box_bounds`]): every pixel a
+    /// triangle with its vertices inside may cover. `None` on non-planar views
+    /// and where the box reaches nearer than `near` (or when no pixel is in it).
+    #[inline]
+    pub(crate) fn node_rect(
+        &self,
+        lo: Vec3,
+        hi: Vec3,
+        view: &View,
+        span: SampleSpan,
+    ) -> Option<PixelRect> {
+        self.map
+            .as_ref()?
+            .box_bounds(lo, hi, view.eye)?
+            .pixels(view, span)
+    }
+}
+
 /// A box of image points, padded.
 #[derive(Clone, Copy, Debug)]
 struct ImageBox {
@@ -370,7 +427,8 @@ mod tests {
     }
 
     /// Every sample the 3D edge functions cover lies in the triangle's screen
-    /// box, on views that stress the box's rounding bound:
+    /// box, and in the screen box of the triangle's bounding box (what
+    /// occlusion culling of a BVH node reads), on views that stress the box's rounding bound:
     /// extreme zoom, 16384-pixel images, cameras far from the origin,
     /// orthographic views, triangles crossing the near plane, and vertices
     /// placed on sample rays (where rounding alone decides coverage).
@@ -381,7 +439,7 @@ mod tests {
     #[test]
     fn screen_boxes_hold_every_covered_sample() {
         let mut rng = fastrand::Rng::with_seed(11);
-        let (mut covered, mut boxes) = (0u64, 0u64);
+        let (mut covered, mut boxes, mut in_nodes) = (0u64, 0u64, 0u64);
         for case in 0..400 {
             let far = [0.0, 1e3, 3e5][case % 3];
             let eye = Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5) * 4.0
@@ -442,6 +500,8 @@ mod tests {
                 let vertices = [3 * k as u32, 3 * k as u32 + 1, 3 * k as u32 + 2];
                 let rect = screen.rect(&p, vertices, &view, pattern.span);
                 boxes += u64::from(rect.is_some());
+                let (lo, hi) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
+                let node = screen.node_rect(lo, hi, &view, pattern.span);
                 // Coverage is only meaningful where the orientation is: skip
                 // triangles so nearly edge-on that f64 cannot tell (the f64
                 // setup has no exact fallback; the f32 one decides exactly).
@@ -502,6 +562,13 @@ mod tests {
                                     inside,
                                     "case {case}: sample ({sx}, {sy}) of {p:?} is covered but outside {rect:?} ({view:?})"
                                 );
+                                if let Some(n) = node {
+                                    in_nodes += 1;
+                                    assert!(
+                                        n.contains(px, py),
+                                        "case {case}: sample ({sx}, {sy}) of {p:?} is covered but outside its box's {n:?} ({view:?})"
+                                    );
+                                }
                             }
                         }
                     }
@@ -510,8 +577,8 @@ mod tests {
         }
         // The test must have tested something.
         assert!(
-            covered > 10_000 && boxes > 3_000,
-            "{covered} covered samples, {boxes} boxes"
+            covered > 10_000 && boxes > 3_000 && in_nodes > 5_000,
+            "{covered} covered samples, {boxes} boxes, {in_nodes} in node boxes"
         );
     }
 

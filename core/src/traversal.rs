@@ -171,7 +171,7 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
                 .record(|t| t.nodes.push(node_box(NodeOutcome::Outside)));
             return;
         }
-        if self.oracles.occluded && b.min_w > self.tile.hiz_max(f) {
+        if self.oracles.occluded && self.is_occluded(frustum, &b) {
             self.counters.nodes_culled_occluded += 1;
             self.tile
                 .record(|t| t.nodes.push(node_box(NodeOutcome::Occluded)));
@@ -250,6 +250,25 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
         let fw = Vec3A::from(v.forward);
         let far = Vec3A::select(fw.cmpge(Vec3A::ZERO), b.hi, b.lo);
         (far - eye).dot(fw) < v.near
+    }
+
+    /// Is the box behind what the hierarchical w-buffer holds: over the whole
+    /// frustum, or over the pixels its screen box reaches in it when some
+    /// other pixels of the frustum are still empty ([`crate::hiz`])?
+    fn is_occluded(&self, f: &Frustum, b: &NodeBox) -> bool {
+        let (farthest, nearest) = self.tile.hiz.depths(f.rect);
+        if b.min_w > farthest {
+            return true;
+        }
+        if b.min_w <= nearest {
+            // Not behind any cell's held depths: no need to project the box.
+            return false;
+        }
+        let span = self.tile.pattern.span;
+        self.boxes
+            .node_rect(b.lo.into(), b.hi.into(), self.view, span)
+            .and_then(|r| r.intersect(f.rect))
+            .is_some_and(|r| self.tile.hiz.hides(r, b.min_w))
     }
 
     /// Split when the frustum is still larger than `min` and the node is not a

@@ -536,6 +536,19 @@ fn compare_measures_each_thread_count() {
     assert_eq!(doc["machine"]["threads"], serde_json::json!([1, 2]));
     let html = std::fs::read_to_string(dir.join("report.html")).expect("report.html");
     assert!(html.contains("id=\"stages\"") && html.contains("id=\"threads\""));
+    // 3dr-full walks the BVH: its counters in the report and the CSV.
+    assert!(html.contains("id=\"traversal\""));
+    let csv = std::fs::read_to_string(dir.join("results.csv")).expect("results.csv");
+    let mut lines = csv.lines().map(|l| l.split(',').collect::<Vec<_>>());
+    let header = lines.next().expect("a header");
+    let column = |name: &str| header.iter().position(|h| *h == name).expect(name);
+    let (visited, outside) = (column("bvh_nodes_visited"), column("nodes_culled_outside"));
+    let full: Vec<_> = lines.filter(|l| l[1] == "3dr-full").collect();
+    assert_eq!(full.len(), 2, "{csv}");
+    for l in full {
+        let n = |i: usize| l[i].parse::<u64>().expect("a count");
+        assert!(n(visited) > 0 && n(outside) <= n(visited), "{l:?}");
+    }
     let bad = continuum(&["compare", "--threads", "0,2", "--out", "/tmp/never"]);
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--threads"));

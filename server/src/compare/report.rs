@@ -66,6 +66,7 @@ pre {{ background: #f7f7f7; padding: 8px; font-size: 11px; overflow-x: auto; }}
         );
     }
     sect5(&mut h, rows);
+    traversal(&mut h, rows);
     peers(&mut h, rows);
     agreement(&mut h, rows);
     all_rows(&mut h, rows);
@@ -480,6 +481,36 @@ fn peers(h: &mut String, rows: &[Row]) {
                     .map_or("–".into(), |d| d.to_string())
             );
         }
+    }
+    h.push_str("</table>\n");
+}
+
+/// The counters that explain a BVH algorithm's time: per row, the nodes its
+/// frusta (or ray packets) visited, those culled as outside and as occluded
+/// (paper Fig. 6a), the frusta split (Fig. 6b, c) and the leaf triangles set up.
+fn traversal(h: &mut String, rows: &[Row]) {
+    let count = |r: &Row, k: &str| r.stats.get(k).and_then(Value::as_u64).unwrap_or(0);
+    let walks = |r: &&Row| count(r, "bvh_nodes_visited") > 0;
+    if !rows.iter().any(|r| walks(&r)) {
+        return;
+    }
+    h.push_str("<h2 id=\"traversal\">BVH traversal</h2>\n<p>Per row: the nodes visited (a culled node counts once, its subtree not at all), those culled as outside the frustum and as occluded behind the hierarchical w-buffer (<em>culled</em> share of the visits in brackets), the frusta split and the leaf triangles set up. <code>raycast</code> counts the nodes its packets entered.</p>\n<table><tr><th class=\"l\">scene</th><th class=\"l\">algorithm</th><th class=\"l\">viewport</th><th class=\"l\">aa</th><th>median ms</th><th>nodes visited</th><th>outside</th><th>occluded</th><th>frusta split</th><th>setups</th></tr>\n");
+    for r in rows.iter().filter(walks) {
+        let visited = count(r, "bvh_nodes_visited");
+        let share = |n: u64| format!("{n} ({:.0}%)", 100.0 * n as f64 / visited as f64);
+        let _ = writeln!(
+            h,
+            "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{:.2}</td><td>{visited}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            escape(&r.scene),
+            escape(&r.algorithm),
+            escape(&r.viewport),
+            escape(&r.aa),
+            r.median_ms,
+            share(count(r, "nodes_culled_outside")),
+            share(count(r, "nodes_culled_occluded")),
+            count(r, "frusta_split"),
+            count(r, "triangle_setups"),
+        );
     }
     h.push_str("</table>\n");
 }
