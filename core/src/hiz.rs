@@ -63,13 +63,34 @@ impl Hiz {
         hiz
     }
 
-    /// Empty cells over the pixels of `rect` (the memory kept).
+    /// Empty cells over the pixels of `rect` (the memory kept); the cells
+    /// along its right and bottom edges with their bits beyond it set.
     pub fn reset(&mut self, rect: PixelRect) {
         self.rect = rect;
-        self.columns = rect.width().div_ceil(HIZ_CELL);
-        let cells = (self.columns * rect.height().div_ceil(HIZ_CELL)) as usize;
+        let (width, height) = (rect.width(), rect.height());
+        self.columns = width.div_ceil(HIZ_CELL);
+        let rows = height.div_ceil(HIZ_CELL);
         self.cells.clear();
-        self.cells.resize(cells, EMPTY);
+        self.cells.resize((self.columns * rows) as usize, EMPTY);
+        if self.cells.is_empty() {
+            return;
+        }
+        let beyond = |cx: u32, cy: u32| {
+            let inside = |n: u32, base: u32| n.min(base + HIZ_CELL) - base;
+            !cell_bits(
+                0,
+                inside(width, cx * HIZ_CELL),
+                0,
+                inside(height, cy * HIZ_CELL),
+            )
+        };
+        for cy in 0..rows {
+            self.cells[((cy + 1) * self.columns - 1) as usize].covered =
+                beyond(self.columns - 1, cy);
+        }
+        for cx in 0..self.columns {
+            self.cells[((rows - 1) * self.columns + cx) as usize].covered = beyond(cx, rows - 1);
+        }
     }
 
     /// Each cell that the pixels of the non-empty `r` (inside the tile)
@@ -134,42 +155,83 @@ impl Hiz {
             .all(|(c, bits)| c.covered & bits == bits && w > c.far)
     }
 
-    /// Recomputes the cells that the pixels of `r` touch from the tile's
-    /// stored depths (`depth`: layer-major, `pixels` per layer).
+    /// Brings the cells that the pixels of `r` touch up to date after writes
+    /// inside `r` (`depth`: the tile's stored depths, layer-major, `pixels`
+    /// per layer). Stored depths only decrease, so only `r`'s pixels are read:
+    /// their mask bits are recomputed, and the farthest held depth rises to
+    /// theirs — an upper bound, which is all [`Hiz::hides`] needs. Once a
+    /// cell is covered whole its farthest depth is kept exact (what
+    /// [`Hiz::farthest`] reports): the whole cell is read again when it has
+    /// just become covered, or when `r`'s depths fell below it (the farthest
+    /// may have been one of them).
     pub fn update(&mut self, r: PixelRect, depth: &[f32], pixels: usize) {
         let t = self.rect;
-        let (cx0, cx1) = ((r.x0 - t.x0) / HIZ_CELL, (r.x1 - 1 - t.x0) / HIZ_CELL + 1);
-        let (cy0, cy1) = ((r.y0 - t.y0) / HIZ_CELL, (r.y1 - 1 - t.y0) / HIZ_CELL + 1);
-        let width = t.width() as usize;
-        for cy in cy0..cy1 {
-            for cx in cx0..cx1 {
-                let (px0, py0) = ((cx * HIZ_CELL) as usize, cy * HIZ_CELL);
-                let columns = (HIZ_CELL as usize).min(width - px0);
-                let rows = HIZ_CELL.min(t.height() - py0);
-                let mut far = f32x8::splat(f32::NEG_INFINITY);
-                let mut covered = u64::MAX;
-                for row in 0..rows {
-                    let start = (py0 + row) as usize * width + px0;
-                    // Bit k: pixel k of the row holds every sample so far.
-                    let mut held = 0xff;
-                    for layer in depth.chunks_exact(pixels) {
-                        let v = f32x8::from(std::array::from_fn(|k| {
-                            if k < columns {
-                                layer[start + k]
-                            } else {
-                                f32::NEG_INFINITY
-                            }
-                        }));
-                        let finite = v.is_finite();
-                        held &= finite.to_bitmask() | (0xff << columns);
-                        far = far.fast_max(finite.bitselect(v, f32x8::splat(f32::NEG_INFINITY)));
-                    }
-                    covered &= !(u64::from(!held & 0xff) << (8 * row));
-                }
-                let far = far.to_array().into_iter().fold(f32::NEG_INFINITY, f32::max);
-                self.cells[(cy * self.columns + cx) as usize] = Cell { far, covered };
+        let (lx0, ly0, lx1, ly1) = (r.x0 - t.x0, r.y0 - t.y0, r.x1 - t.x0, r.y1 - t.y0);
+        for cy in ly0 / HIZ_CELL..(ly1 - 1) / HIZ_CELL + 1 {
+            for cx in lx0 / HIZ_CELL..(lx1 - 1) / HIZ_CELL + 1 {
+                let (bx, by) = (cx * HIZ_CELL, cy * HIZ_CELL);
+                let span = |lo: u32, hi: u32, base: u32| {
+                    (lo.max(base) - base, hi.min(base + HIZ_CELL) - base)
+                };
+                let (x0, x1) = span(lx0, lx1, bx);
+                let (y0, y1) = span(ly0, ly1, by);
+                let i = (cy * self.columns + cx) as usize;
+                let old = self.cells[i];
+                let (held, far) = self.read(depth, pixels, (bx, by), (x0, x1), (y0, y1));
+                let bits = cell_bits(x0, x1, y0, y1);
+                let covered = old.covered & !bits | held;
+                let far = if covered != u64::MAX {
+                    old.far.max(far)
+                } else if old.covered == u64::MAX && far >= old.far {
+                    // The other pixels are unchanged and no farther than before.
+                    far
+                } else {
+                    self.read(depth, pixels, (bx, by), (0, HIZ_CELL), (0, HIZ_CELL))
+                        .1
+                };
+                self.cells[i] = Cell { far, covered };
             }
         }
+    }
+
+    /// Over the pixel columns `x0..x1` and rows `y0..y1` of the cell at
+    /// tile-local `origin` (clipped to the tile): the mask bits of the pixels
+    /// whose every sample holds a depth, and the farthest depth held.
+    #[inline]
+    fn read(
+        &self,
+        depth: &[f32],
+        pixels: usize,
+        (bx, by): (u32, u32),
+        (x0, x1): (u32, u32),
+        (y0, y1): (u32, u32),
+    ) -> (u64, f32) {
+        let width = self.rect.width();
+        let (x1, y1) = (x1.min(width - bx), y1.min(self.rect.height() - by));
+        let lanes = (0xff >> (8 - (x1 - x0))) << x0;
+        let empty = f32x8::splat(f32::NEG_INFINITY);
+        let mut far = empty;
+        let mut held = 0u64;
+        for row in y0..y1 {
+            let start = ((by + row) * width + bx) as usize;
+            let mut row_held = lanes;
+            for layer in depth.chunks_exact(pixels) {
+                let v = f32x8::from(std::array::from_fn(|k| {
+                    let k = k as u32;
+                    if (x0..x1).contains(&k) {
+                        layer[start + k as usize]
+                    } else {
+                        f32::NEG_INFINITY
+                    }
+                }));
+                let finite = v.is_finite();
+                row_held &= finite.to_bitmask();
+                far = far.fast_max(finite.bitselect(v, empty));
+            }
+            held |= u64::from(row_held) << (8 * row);
+        }
+        let far = far.to_array().into_iter().fold(f32::NEG_INFINITY, f32::max);
+        (held, far)
     }
 }
 
@@ -253,5 +315,75 @@ mod tests {
         assert!(!hiz.hides(PixelRect::new(1, 1, 2, 2), 2.0));
         assert!(hiz.hides(PixelRect::new(2, 1, 8, 8), 2.0));
         assert_eq!(hiz.farthest(rect), f32::INFINITY);
+    }
+
+    /// Random writes (depths only decrease, as the depth test keeps them),
+    /// each followed by an update of its rectangle: `farthest` is always the
+    /// exact farthest depth over the touched cells (`+∞` with an empty
+    /// sample), and `hides` never hides a sample at or beyond `w`.
+    #[test]
+    fn updates_keep_farthest_exact_and_hides_sound() {
+        let mut rng = fastrand::Rng::with_seed(3);
+        let (mut hidden, mut checked) = (0, 0);
+        for case in 0..60 {
+            let rect = PixelRect::new(8, 16, 8 + rng.u32(1..40), 16 + rng.u32(1..30));
+            let (w, h) = (rect.width(), rect.height());
+            let layers = 1 + case % 3;
+            let pixels = (w * h) as usize;
+            let mut depth = vec![f32::INFINITY; pixels * layers];
+            let mut hiz = Hiz::new(rect);
+            let random_rect = |rng: &mut fastrand::Rng| {
+                let (x0, y0) = (rng.u32(0..w), rng.u32(0..h));
+                let (x1, y1) = (rng.u32(x0 + 1..=w), rng.u32(y0 + 1..=h));
+                PixelRect::new(rect.x0 + x0, rect.y0 + y0, rect.x0 + x1, rect.y0 + y1)
+            };
+            for _ in 0..200 {
+                let r = random_rect(&mut rng);
+                for y in r.y0..r.y1 {
+                    for x in r.x0..r.x1 {
+                        for layer in 0..layers {
+                            let i = layer * pixels + ((y - rect.y0) * w + x - rect.x0) as usize;
+                            if rng.u32(0..3) > 0 {
+                                depth[i] = depth[i].min(rng.f32() * 10.0);
+                            }
+                        }
+                    }
+                }
+                hiz.update(r, &depth, pixels);
+                let q = random_rect(&mut rng);
+                // Brute force over the cells `q` touches.
+                let cell = |v: u32, o: u32| (v - o) / HIZ_CELL;
+                let mut farthest = f32::NEG_INFINITY;
+                for y in rect.y0..rect.y1 {
+                    for x in rect.x0..rect.x1 {
+                        let (cx, cy) = (cell(x, rect.x0), cell(y, rect.y0));
+                        let cols = cell(q.x0, rect.x0)..=cell(q.x1 - 1, rect.x0);
+                        let rows = cell(q.y0, rect.y0)..=cell(q.y1 - 1, rect.y0);
+                        if cols.contains(&cx) && rows.contains(&cy) {
+                            for layer in 0..layers {
+                                let i = layer * pixels + ((y - rect.y0) * w + x - rect.x0) as usize;
+                                farthest = farthest.max(depth[i]);
+                            }
+                        }
+                    }
+                }
+                assert_eq!(hiz.farthest(q), farthest, "case {case}: {q:?} in {rect:?}");
+                let at = rng.f32() * 11.0;
+                if hiz.hides(q, at) {
+                    hidden += 1;
+                    for y in q.y0..q.y1 {
+                        for x in q.x0..q.x1 {
+                            for layer in 0..layers {
+                                let i = layer * pixels + ((y - rect.y0) * w + x - rect.x0) as usize;
+                                assert!(depth[i] < at, "case {case}: ({x}, {y}) hidden at {at}");
+                            }
+                        }
+                    }
+                }
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 60 * 200);
+        assert!(hidden > 1000, "{hidden} hidden");
     }
 }
