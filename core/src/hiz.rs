@@ -118,6 +118,7 @@ impl Hiz {
 
     /// The farthest stored depth over the cells that the pixels of `r` touch
     /// (`+∞` while any of their samples is empty).
+    #[inline]
     pub fn farthest(&self, r: PixelRect) -> f32 {
         self.depths(r).0
     }
@@ -127,9 +128,12 @@ impl Hiz {
     /// that depth or nearer is hidden anywhere in `r`.
     #[inline]
     pub fn depths(&self, r: PixelRect) -> (f32, f32) {
-        self.touched(r).fold(
-            (f32::NEG_INFINITY, f32::INFINITY),
-            |(farthest, nearest), (c, _)| {
+        let t = self.rect;
+        let (cx0, cx1) = ((r.x0 - t.x0) / HIZ_CELL, (r.x1 - 1 - t.x0) / HIZ_CELL + 1);
+        let (mut farthest, mut nearest) = (f32::NEG_INFINITY, f32::INFINITY);
+        for cy in (r.y0 - t.y0) / HIZ_CELL..(r.y1 - 1 - t.y0) / HIZ_CELL + 1 {
+            let row = (cy * self.columns) as usize;
+            for c in &self.cells[row + cx0 as usize..row + cx1 as usize] {
                 let whole = if c.covered == u64::MAX {
                     c.far
                 } else {
@@ -140,9 +144,11 @@ impl Hiz {
                 } else {
                     f32::INFINITY
                 };
-                (farthest.max(whole), nearest.min(held))
-            },
-        )
+                farthest = farthest.max(whole);
+                nearest = nearest.min(held);
+            }
+        }
+        (farthest, nearest)
     }
 
     /// Is everything at depth `w` hidden over the pixels of `r`: every stored
