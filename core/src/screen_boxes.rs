@@ -302,9 +302,7 @@ impl ScreenBoxes {
         let points = vertices.map(|v| self.points[v as usize]);
         map.image_box(p, &points, view)?.pixels(view, span)
     }
-}
 
-impl ScreenBoxes {
     /// The pixels with a sample in a conservative screen box of the
     /// axis-aligned box `lo..hi` ([`ImageMap::box_bounds`]): every pixel a
     /// triangle with its vertices inside may cover. `None` on non-planar views
