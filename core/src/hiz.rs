@@ -20,8 +20,9 @@ pub const HIZ_CELL: u32 = 8;
 
 #[derive(Clone, Copy, Debug)]
 struct Cell {
-    /// The farthest depth over the cell's samples that hold one
-    /// (`−∞` when none does).
+    /// No nearer than the farthest depth over the cell's samples that hold
+    /// one, and exactly it once every pixel is covered (`−∞` when none holds
+    /// one): see [`Hiz::update`].
     far: f32,
     /// Bit `8·row + column`: every stored sample of that pixel holds a depth.
     /// Bits of pixels beyond the tile's edge are set (nothing lies there).
