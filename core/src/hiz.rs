@@ -203,7 +203,11 @@ impl Hiz {
 
     /// Over the pixel columns `x0..x1` and rows `y0..y1` of the cell at
     /// tile-local `origin` (clipped to the tile): the mask bits of the pixels
-    /// whose every sample holds a depth, and the farthest depth held.
+    /// whose every sample holds a depth, and the farthest depth held — over
+    /// whole rows of the cell where it lies inside the tile (one load of eight
+    /// lanes): the other pixels of those rows are unchanged since the last
+    /// update, so no farther than the cell's farthest depth (which
+    /// [`Hiz::update`] compares with).
     #[inline]
     fn read(
         &self,
@@ -214,23 +218,29 @@ impl Hiz {
         (y0, y1): (u32, u32),
     ) -> (u64, f32) {
         let width = self.rect.width();
-        let (x1, y1) = (x1.min(width - bx), y1.min(self.rect.height() - by));
+        let columns = HIZ_CELL.min(width - bx);
+        let (x1, y1) = (x1.min(columns), y1.min(self.rect.height() - by));
         let lanes = (0xff >> (8 - (x1 - x0))) << x0;
         let empty = f32x8::splat(f32::NEG_INFINITY);
         let mut far = empty;
         let mut held = 0u64;
+        let layers = depth.len() / pixels;
         for row in y0..y1 {
             let start = ((by + row) * width + bx) as usize;
             let mut row_held = lanes;
-            for layer in depth.chunks_exact(pixels) {
-                let v = f32x8::from(std::array::from_fn(|k| {
-                    let k = k as u32;
-                    if (x0..x1).contains(&k) {
-                        layer[start + k as usize]
-                    } else {
-                        f32::NEG_INFINITY
-                    }
-                }));
+            for layer in 0..layers {
+                let start = layer * pixels + start;
+                let v = if columns == HIZ_CELL {
+                    f32x8::from(std::array::from_fn(|k| depth[start + k]))
+                } else {
+                    f32x8::from(std::array::from_fn(|k| {
+                        if (k as u32) < columns {
+                            depth[start + k]
+                        } else {
+                            f32::NEG_INFINITY
+                        }
+                    }))
+                };
                 let finite = v.is_finite();
                 row_held &= finite.to_bitmask();
                 far = far.fast_max(finite.bitselect(v, empty));
