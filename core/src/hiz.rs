@@ -52,6 +52,20 @@ fn cell_bits(x0: u32, x1: u32, y0: u32, y1: u32) -> u64 {
     row * rows
 }
 
+/// The cells (along one axis) that the tile-local pixels `lo..hi` touch.
+#[inline]
+fn cells(lo: u32, hi: u32) -> std::ops::Range<u32> {
+    lo / HIZ_CELL..(hi - 1) / HIZ_CELL + 1
+}
+
+/// The part of the tile-local pixels `lo..hi` (along one axis) in cell `c`,
+/// cell-local.
+#[inline]
+fn span(lo: u32, hi: u32, c: u32) -> (u32, u32) {
+    let base = c * HIZ_CELL;
+    (lo.max(base) - base, hi.min(base + HIZ_CELL) - base)
+}
+
 impl Hiz {
     /// Empty cells over the pixels of `rect`.
     pub fn new(rect: PixelRect) -> Hiz {
@@ -94,23 +108,22 @@ impl Hiz {
         }
     }
 
+    /// The non-empty `r` (inside the tile) in tile-local pixels.
+    #[inline]
+    fn local(&self, r: PixelRect) -> [u32; 4] {
+        let t = self.rect;
+        [r.x0 - t.x0, r.y0 - t.y0, r.x1 - t.x0, r.y1 - t.y0]
+    }
+
     /// Each cell that the pixels of the non-empty `r` (inside the tile)
     /// touch, with the mask bits of `r`'s pixels in it.
     #[inline]
     fn touched(&self, r: PixelRect) -> impl Iterator<Item = (&Cell, u64)> {
-        let t = self.rect;
-        let (lx0, ly0, lx1, ly1) = (r.x0 - t.x0, r.y0 - t.y0, r.x1 - t.x0, r.y1 - t.y0);
-        let (cx0, cx1) = (lx0 / HIZ_CELL, (lx1 - 1) / HIZ_CELL + 1);
-        let (cy0, cy1) = (ly0 / HIZ_CELL, (ly1 - 1) / HIZ_CELL + 1);
-        // Cell-local span of `r` along one axis in cell `c`.
-        let local = |c: u32, lo: u32, hi: u32| {
-            let base = c * HIZ_CELL;
-            (lo.max(base) - base, hi.min(base + HIZ_CELL) - base)
-        };
-        (cy0..cy1).flat_map(move |cy| {
-            let (y0, y1) = local(cy, ly0, ly1);
-            (cx0..cx1).map(move |cx| {
-                let (x0, x1) = local(cx, lx0, lx1);
+        let [lx0, ly0, lx1, ly1] = self.local(r);
+        cells(ly0, ly1).flat_map(move |cy| {
+            let (y0, y1) = span(ly0, ly1, cy);
+            cells(lx0, lx1).map(move |cx| {
+                let (x0, x1) = span(lx0, lx1, cx);
                 let cell = &self.cells[(cy * self.columns + cx) as usize];
                 (cell, cell_bits(x0, x1, y0, y1))
             })
@@ -129,12 +142,12 @@ impl Hiz {
     /// that depth or nearer is hidden anywhere in `r`.
     #[inline]
     pub fn depths(&self, r: PixelRect) -> (f32, f32) {
-        let t = self.rect;
-        let (cx0, cx1) = ((r.x0 - t.x0) / HIZ_CELL, (r.x1 - 1 - t.x0) / HIZ_CELL + 1);
+        let [lx0, ly0, lx1, ly1] = self.local(r);
+        let columns = cells(lx0, lx1);
         let (mut farthest, mut nearest) = (f32::NEG_INFINITY, f32::INFINITY);
-        for cy in (r.y0 - t.y0) / HIZ_CELL..(r.y1 - 1 - t.y0) / HIZ_CELL + 1 {
+        for cy in cells(ly0, ly1) {
             let row = (cy * self.columns) as usize;
-            for c in &self.cells[row + cx0 as usize..row + cx1 as usize] {
+            for c in &self.cells[row + columns.start as usize..row + columns.end as usize] {
                 let whole = if c.covered == u64::MAX {
                     c.far
                 } else {
@@ -172,16 +185,12 @@ impl Hiz {
     /// just become covered, or when `r`'s depths fell below it (the farthest
     /// may have been one of them).
     pub fn update(&mut self, r: PixelRect, depth: &[f32], pixels: usize) {
-        let t = self.rect;
-        let (lx0, ly0, lx1, ly1) = (r.x0 - t.x0, r.y0 - t.y0, r.x1 - t.x0, r.y1 - t.y0);
-        for cy in ly0 / HIZ_CELL..(ly1 - 1) / HIZ_CELL + 1 {
-            for cx in lx0 / HIZ_CELL..(lx1 - 1) / HIZ_CELL + 1 {
+        let [lx0, ly0, lx1, ly1] = self.local(r);
+        for cy in cells(ly0, ly1) {
+            for cx in cells(lx0, lx1) {
                 let (bx, by) = (cx * HIZ_CELL, cy * HIZ_CELL);
-                let span = |lo: u32, hi: u32, base: u32| {
-                    (lo.max(base) - base, hi.min(base + HIZ_CELL) - base)
-                };
-                let (x0, x1) = span(lx0, lx1, bx);
-                let (y0, y1) = span(ly0, ly1, by);
+                let (x0, x1) = span(lx0, lx1, cx);
+                let (y0, y1) = span(ly0, ly1, cy);
                 let i = (cy * self.columns + cx) as usize;
                 let old = self.cells[i];
                 let (held, far) = self.read(depth, pixels, (bx, by), (x0, x1), (y0, y1));
