@@ -272,7 +272,7 @@ impl ScreenBoxes {
     }
 
     /// The boxes of triangles over mesh vertices `positions`.
-    fn of(positions: &[Vec3], view: &View) -> ScreenBoxes {
+    pub(crate) fn of(positions: &[Vec3], view: &View) -> ScreenBoxes {
         let map = view.sphere.is_none().then(|| ImageMap::new(view));
         let points = match &map {
             Some(map) => (positions.par_iter())

@@ -343,6 +343,36 @@ impl<'a> Triangle3D<'a> {
         ]
     }
 
+    /// The triangle as the GPU kernels read it (`Tri` in `gpu/compute.wgsl`,
+    /// linear layout): rows 0..2 `(A_i | nd0)`, `(B_i | nd1)`, `(C_i | nd2)`,
+    /// row 3 `(volume, w_min)`, row 4 `(w_max, 0, 0, 0)`, row 5 the
+    /// tolerances; and the flags (tie ownership per edge by the f32
+    /// derivatives, which the kernels use only where an edge has no
+    /// tolerance).
+    #[cfg(feature = "gpu")]
+    pub(crate) fn gpu_rows(&self) -> ([[f32; 4]; 6], u32) {
+        let mut flags = 0;
+        for i in 0..3 {
+            let (b, c) = (self.b[i], self.c[i]);
+            flags |= u32::from(b > 0.0 || (b == 0.0 && c > 0.0)) << i;
+        }
+        let [t0, t1, t2] = self.tolerance;
+        let rows = [
+            [self.a[0], self.a[1], self.a[2], self.nd[0]],
+            [self.b[0], self.b[1], self.b[2], self.nd[1]],
+            [self.c[0], self.c[1], self.c[2], self.nd[2]],
+            [
+                self.volume[0],
+                self.volume[1],
+                self.volume[2],
+                self.w_range[0],
+            ],
+            [self.w_range[1], 0.0, 0.0, 0.0],
+            [t0, t1, t2, 0.0],
+        ];
+        (rows, flags)
+    }
+
     /// Is the sample at `(x, y)` with f32 edge values `e` inside all three
     /// edges? The f32 sign where it is certain, the exact one where it is not.
     #[inline(always)]

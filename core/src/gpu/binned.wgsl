@@ -27,7 +27,9 @@ const ACCEPTED_BIT: u32 = 0x80000000u;
 // Where tile (tx, ty) stands against triangle t: its samples' box tested at
 // the corners where each edge is largest and smallest (the edge functions
 // are linear in the image point), with a margin of 2⁻²⁰ of the terms'
-// magnitudes for the f32 rounding of a corner against a sample.
+// magnitudes for the f32 rounding of a corner against a sample, beyond the
+// edge's own tolerance: a tile is rejected or accepted only where every
+// sample's decision is certain (the exact one).
 fn tile_test(t: Tri, tx: u32, ty: u32) -> u32 {
     let x0 = f32(tx * TILE) + P.span.x;
     let y0 = f32(ty * TILE) + P.span.y;
@@ -40,7 +42,7 @@ fn tile_test(t: Tri, tx: u32, ty: u32) -> u32 {
         let c = t.r[2][i];
         let hi = a + select(x0, x1, b > 0.0) * b + select(y0, y1, c > 0.0) * c;
         let lo = a + select(x1, x0, b > 0.0) * b + select(y1, y0, c > 0.0) * c;
-        let margin = 9.5367432e-7 * (abs(a) + x1 * abs(b) + y1 * abs(c));
+        let margin = 9.5367432e-7 * (abs(a) + x1 * abs(b) + y1 * abs(c)) + t.r[5][i];
         if hi < -margin {
             return REJECT;
         }
@@ -179,14 +181,20 @@ fn test_sample(best: ptr<function, Best>, t: Tri, accepted: bool, s: u32, x: u32
     let sx = f32(x) + o.x;
     let sy = f32(y) + o.y;
     let e = edges(t, sx, sy);
-    if !(accepted || covers(t, e)) {
-        return;
+    let id = bitcast<u32>(t.r[6].x);
+    if !accepted {
+        let side = covers(t, e);
+        if side == UNSURE {
+            defer(id, s * P.size.x * P.size.y + y * P.size.x + x);
+        }
+        if side != INSIDE {
+            return;
+        }
     }
     let w = depth(t, e, sx, sy);
     if w < 0.0 {
         return;
     }
-    let id = bitcast<u32>(t.r[6].x);
     (*best).writes += 1u;
     let nearer = select(w < (*best).w || (w == (*best).w && id < (*best).id), id < (*best).id, P.flags.x == 1u);
     if (*best).id == EMPTY || nearer {

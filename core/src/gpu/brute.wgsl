@@ -19,14 +19,18 @@ fn raster_pixel(t: Tri, id: u32, x: u32, y: u32) {
         let sx = f32(x) + o.x;
         let sy = f32(y) + o.y;
         let e = edges(t, sx, sy);
-        if !covers(t, e) {
+        let side = covers(t, e);
+        let i = s * pixels + pixel;
+        if side != INSIDE {
+            if side == UNSURE && counting {
+                defer(id, i);
+            }
             continue;
         }
         let w = depth(t, e, sx, sy);
         if w < 0.0 {
             continue;
         }
-        let i = s * pixels + pixel;
         if counting {
             atomicAdd(&coverage_writes[i], 1u);
         }

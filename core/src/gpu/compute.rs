@@ -49,8 +49,14 @@ pub(crate) struct ComputeSamples {
     pub edge_evals: Vec<u32>,
     /// Triangles (2D: pieces) set up with a box on screen.
     pub setups: u64,
-    /// 2D: triangles the CPU clipped.
-    pub clipped: u64,
+    /// Triangles the CPU set up (2D: clipped; 3D and homogeneous: of
+    /// unsure orientation).
+    pub on_cpu: u64,
+    /// (triangle id, layer-major sample index) pairs whose coverage f32 was
+    /// not sure of: the CPU decides them exactly and merges the covered
+    /// ones (their depth and id are not in `triangle_id`, `depth`,
+    /// `coverage_writes`; their edge evaluations are in `edge_evals`).
+    pub unsure: Vec<[u32; 2]>,
     /// Binned: tile tests, tiles accepted whole, tiles rejected.
     pub tiles: [u64; 3],
     /// Host milliseconds from submit to a finished device poll: setup
@@ -69,6 +75,11 @@ const CHUNK: u32 = 64;
 const SEGMENT: u32 = 16_384;
 /// Words of the counters buffer.
 const COUNTERS: u64 = 16;
+/// Room first made for the samples left to the CPU's exact decision, in
+/// (id, sample) pairs: a few per thousand samples near edges at most on
+/// the built-in scenes; a render that finds more runs again with room for
+/// all.
+const UNSURE_ROOM: u32 = 1 << 16;
 
 /// `box_chunks` of compute.wgsl: the chunks of `CHUNK²` pixels or of 8×8
 /// tiles a box `[x0, y0, x1, y1)` spans, whichever is more.
@@ -153,7 +164,7 @@ fn params(
     count: u32,
     tiles: [u32; 2],
     pass: u32,
-    flags: [u32; 3],
+    flags: [u32; 4],
 ) -> Vec<u8> {
     let mut floats: Vec<f32> = Vec::with_capacity(48);
     for v in [
@@ -190,7 +201,7 @@ fn params(
         flags[0],
         flags[1],
         flags[2],
-        0,
+        flags[3],
     ];
     bytes.extend(words.iter().flat_map(|w| w.to_le_bytes()));
     bytes
@@ -470,9 +481,11 @@ impl Gpu {
     }
 
     /// Renders `view` of `mesh` with the compute pipeline `kind`: setup,
-    /// (binning,) raster, read-back. `clip` sets up, on the CPU, the pieces
-    /// of the triangles the 2D setup kernel listed as crossing the near
-    /// plane or the guard band (as `2dr-brute` clips them).
+    /// (binning,) raster, read-back. `cpu_setup` sets up, on the CPU, the
+    /// triangles the setup kernel listed: for 2D the pieces of those that
+    /// cross the near plane or the guard band (as `2dr-brute` clips them),
+    /// for 3D and homogeneous those whose orientation f32 cannot be sure of
+    /// (with the exact sign, as the CPU's setups take it).
     pub(crate) fn compute(
         &self,
         mesh: &GpuMesh,
@@ -480,16 +493,30 @@ impl Gpu {
         view: &View,
         pattern: &SamplePattern,
         (atomics, depth_test): (GpuAtomics, bool),
-        clip: &dyn Fn(&[u32]) -> Vec<TriWords>,
+        cpu_setup: &dyn Fn(&[u32]) -> Vec<TriWords>,
     ) -> Result<ComputeSamples, GpuError> {
         self.fits(view)?;
         let _one_at_a_time = self.lock.lock().unwrap_or_else(|e| e.into_inner());
-        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let result = self.compute_scoped(mesh, kind, view, pattern, (atomics, depth_test), clip);
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(GpuError::Failed(e.to_string()));
+        let mut room = UNSURE_ROOM;
+        loop {
+            let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+            let result = self.compute_scoped(
+                mesh,
+                kind,
+                view,
+                pattern,
+                (atomics, depth_test, room),
+                cpu_setup,
+            );
+            if let Some(e) = pollster::block_on(scope.pop()) {
+                return Err(GpuError::Failed(e.to_string()));
+            }
+            match result? {
+                Ok(samples) => return Ok(samples),
+                // More unsure samples than room: again, with room for all.
+                Err(needed) => room = needed,
+            }
         }
-        result
     }
 
     fn compute_scoped(
@@ -498,9 +525,9 @@ impl Gpu {
         kind: ComputeKind,
         view: &View,
         pattern: &SamplePattern,
-        (atomics, depth_test): (GpuAtomics, bool),
-        clip: &dyn Fn(&[u32]) -> Vec<TriWords>,
-    ) -> Result<ComputeSamples, GpuError> {
+        (atomics, depth_test, room): (GpuAtomics, bool, u32),
+        cpu_setup: &dyn Fn(&[u32]) -> Vec<TriWords>,
+    ) -> Result<Result<ComputeSamples, u32>, GpuError> {
         let module = match kind {
             ComputeKind::ThreeDBinned => Module::Binned,
             _ if atomics == GpuAtomics::Auto && self.int64_atomics => Module::Brute64,
@@ -511,19 +538,12 @@ impl Gpu {
         let pixels = u64::from(view.width) * u64::from(view.height);
         let samples = pixels * pattern.stored as u64;
         let tiles = [view.width.div_ceil(TILE), view.height.div_ceil(TILE)];
-        // 1. Buffers: the set-up triangles, counters, the clip and big
-        //    lists, the module's own.
+        // 1. Buffers: the set-up triangles, counters, the lists of what the
+        //    CPU finishes and of big triangles, the module's own.
         let mut tris = self.zeroed("triangles", u64::from(n) * 112, "scene")?;
         let counters = self.zeroed("counters", 4 * COUNTERS, "scene")?;
-        let clip_list = self.zeroed(
-            "clip list",
-            if kind == ComputeKind::TwoD {
-                u64::from(n) * 4
-            } else {
-                4
-            },
-            "scene",
-        )?;
+        let setup_list = self.zeroed("triangles for the CPU", u64::from(n) * 4, "scene")?;
+        let unsure_list = self.zeroed("samples for the CPU", u64::from(room) * 8, "size")?;
         let mut big = self.zeroed("big triangles", u64::from(n) * 4, "scene")?;
         let mut own: Vec<wgpu::Buffer> = match module {
             Module::Brute64 => vec![
@@ -562,11 +582,12 @@ impl Gpu {
                 pattern,
                 depth_test,
                 tiles,
+                room,
             },
         };
         let mut out = ComputeSamples::default();
 
-        // 2. Setup; for 2D, the CPU's clipped pieces join the triangles.
+        // 2. Setup; what the CPU sets up joins the triangles.
         let setup = match kind {
             ComputeKind::TwoD => "setup_2d",
             ComputeKind::Homogeneous => "setup_homogeneous",
@@ -575,7 +596,7 @@ impl Gpu {
         let shared = Shared {
             mesh,
             counters: &counters,
-            clip_list: &clip_list,
+            cpu_list: &setup_list,
         };
         let mut encoder = self.device.create_command_encoder(&Default::default());
         let bind = dispatch.bind(&shared, &tris, &big, &own, [n, 0, 0, 0]);
@@ -584,12 +605,12 @@ impl Gpu {
         let mut count = self.counters(&counters)?;
         let mut records = n;
         out.setups = u64::from(count[0]);
-        if kind == ComputeKind::TwoD && count[1] > 0 {
-            let listed = self.read(&[(&clip_list, u64::from(count[1]) * 4)])?;
+        if count[1] > 0 {
+            let listed = self.read(&[(&setup_list, u64::from(count[1]) * 4)])?;
             let ids = words(&listed[0]);
-            out.clipped = ids.len() as u64;
+            out.on_cpu = ids.len() as u64;
             let start = Instant::now();
-            let pieces = clip(&ids);
+            let pieces = cpu_setup(&ids);
             dispatch.wall[0] += start.elapsed().as_secs_f64() * 1e3;
             out.setups += pieces.len() as u64;
             if !pieces.is_empty() {
@@ -623,6 +644,11 @@ impl Gpu {
             }
         }
         let (big_count, chunks) = (count[6], count[8]);
+        // From here on the kernels list unsure samples for the CPU.
+        let shared = Shared {
+            cpu_list: &unsure_list,
+            ..shared
+        };
 
         // 3. Binning (sort-middle only): count, prefix sum, then the lists.
         let mut encoder = self.device.create_command_encoder(&Default::default());
@@ -682,8 +708,20 @@ impl Gpu {
         let resolved = dispatch.clock.resolve(self, &mut encoder);
         dispatch.submit(2, encoder)?;
 
-        // 5. Read back.
+        // 5. Read back: the counters first (the unsure samples may not have
+        //    fit), then the samples.
         let start = Instant::now();
+        let c = self.counters(&counters)?;
+        if c[9] > room {
+            return Ok(Err(c[9]));
+        }
+        out.tiles = [c[2], c[3], c[4]].map(u64::from);
+        if c[9] > 0 {
+            let listed = self.read(&[(&unsure_list, u64::from(c[9]) * 8)])?;
+            out.unsure = (words(&listed[0]).chunks_exact(2))
+                .map(|p| [p[0], p[1]])
+                .collect();
+        }
         let (ids, depth, writes, evals) = match module {
             Module::Brute64 => {
                 let r = self.read(&[
@@ -727,15 +765,12 @@ impl Gpu {
                     (&own[5], samples * 4),
                     (&own[6], samples * 4),
                     (&own[7], pixels * 4),
-                    (&counters, 4 * COUNTERS),
                 ])?;
                 let (ids, depth) = words(&r[1])
                     .into_iter()
                     .zip(words(&r[0]))
                     .map(|(id, w)| visible(id, w))
                     .unzip();
-                let c = words(&r[4]);
-                out.tiles = [c[2], c[3], c[4]].map(u64::from);
                 (ids, depth, words(&r[2]), words(&r[3]))
             }
         };
@@ -767,7 +802,7 @@ impl Gpu {
             (times.setup, times.binning, times.raster) = (stages[0], stages[1], stages[2]);
         }
         out.times = times;
-        Ok(out)
+        Ok(Ok(out))
     }
 
     /// The counters (`counters` in compute.wgsl).
@@ -781,7 +816,8 @@ impl Gpu {
 struct Shared<'a> {
     mesh: &'a GpuMesh,
     counters: &'a wgpu::Buffer,
-    clip_list: &'a wgpu::Buffer,
+    /// What the CPU finishes (`cpu_list` in compute.wgsl).
+    cpu_list: &'a wgpu::Buffer,
 }
 
 /// What the params uniform says besides a dispatch's own words.
@@ -790,6 +826,8 @@ struct Params<'a> {
     pattern: &'a SamplePattern,
     depth_test: bool,
     tiles: [u32; 2],
+    /// Room in the unsure samples' list, in pairs.
+    room: u32,
 }
 
 /// Records the passes of one render: bind groups, timed passes, submissions.
@@ -826,7 +864,7 @@ impl Dispatcher<'_> {
                     count,
                     p.tiles,
                     pass,
-                    [u32::from(!p.depth_test), first, segment],
+                    [u32::from(!p.depth_test), first, segment, p.room],
                 ),
                 usage: wgpu::BufferUsages::UNIFORM,
             });
@@ -837,7 +875,7 @@ impl Dispatcher<'_> {
             &shared.mesh.positions_packed,
             tris,
             shared.counters,
-            shared.clip_list,
+            shared.cpu_list,
             big,
         ];
         let entries: Vec<wgpu::BindGroupEntry> = (buffers.into_iter().chain(own))

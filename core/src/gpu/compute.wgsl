@@ -4,15 +4,22 @@
 // one workgroup per tile). The arithmetic follows the CPU code operation by
 // operation (`edge/edge3d.rs`, `edge/homogeneous.rs`, `edge/edge2d.rs`): the
 // same products in the same order, so results differ only where the driver
-// fuses a multiply and an add, or where the CPU decides a near-zero edge
-// exactly (`edge/exact.rs`), which the GPU does not.
+// fuses a multiply and an add. Where f32 cannot be sure, the CPU decides
+// exactly (`edge/exact.rs`), as it does for its own algorithms: the 3D and
+// homogeneous setups carry the CPU's certified bound on each edge's f32
+// error (`Triangle3D::tolerance`), and a sample whose edge value lies within
+// it is listed for the CPU (`defer`) instead of being decided; a triangle
+// whose orientation (the determinant's f32 sign) is not certain is listed
+// for the CPU's setup. Every other decision is the exact one already.
 //
 // A set-up triangle is a `Tri`: seven vec4s.
 //   linear (3D, homogeneous): r0..r2 = (A_i | nd0), (B_i | nd1), (C_i | nd2),
 //     r3 = (volume, w_min), r4 = (w_max, 0, 0, 0)
 //   2D: r0..r2 = (lo_x, lo_y, Δx, Δy) per edge, r3 = (sign_0..2, q0),
 //     r4 = (q1, q2, w_min, w_max)
-//   r5: unused; r6 = (id, x0 | y0 << 16, x1 | y1 << 16, flags) as u32 bits,
+//   r5 = (tolerance_0..2, 0): per edge the bound on its f32 error over the
+//     image (0 in 2D records: their f32 decision is final);
+//   r6 = (id, x0 | y0 << 16, x1 | y1 << 16, flags) as u32 bits,
 //   flags: bits 0..2 own the tie on edge i, bit 3 a 2D record, bit 4 affine
 //   depth (orthographic 2D). An empty box (x0 >= x1) is no triangle.
 
@@ -42,7 +49,8 @@ struct Params {
     // orthographic, pass (0: depth, 1: ids; the 32-bit fallback), tiles across, tiles down
     mode: vec4<u32>,
     // x: 1 with the depth test off (each sample keeps the smallest id),
-    // y: the first big triangle of this dispatch, z: the list segment
+    // y: the first big triangle of this dispatch, z: the list segment,
+    // w: the capacity of `cpu_list` in (id, sample) pairs (raster passes)
     flags: vec4<u32>,
 }
 
@@ -56,10 +64,13 @@ struct Params {
 // [0] set-up triangles, [1] triangles left to the CPU's clipper,
 // [2] tiles tested, [3] accepted, [4] rejected, [5] list entries,
 // [6] big triangles, [7] the longest tile list, [8] the most chunks a big
-// triangle's box spans
+// triangle's box spans, [9] samples left to the CPU's exact decision
 @group(0) @binding(5) var<storage, read_write> counters: array<atomic<u32>>;
-// Triangles the 2D setup leaves to the CPU's clipper.
-@group(0) @binding(6) var<storage, read_write> clip_list: array<u32>;
+// What the CPU finishes. Setup passes: the ids of the triangles the 2D
+// setup leaves to the CPU's clipper, or whose orientation the 3D and
+// homogeneous setups cannot be sure of. Raster passes: (id, sample index)
+// pairs whose edge decision f32 cannot be sure of.
+@group(0) @binding(6) var<storage, read_write> cpu_list: array<u32>;
 // Triangles whose box holds more than BIG_AREA pixels: rasterized (binned)
 // by workgroups per CHUNK² pixels of their box, not by one thread. (Mesa's
 // llvmpipe ends any invocation after 65,535 loop iterations in all, so no
@@ -153,13 +164,45 @@ fn empty_tri() -> Tri {
     return t;
 }
 
+// |a| ⊗ |b| (`edge3d::abs_cross`): per component the magnitudes of the two
+// products a cross-product component subtracts, which bound its rounding.
+fn abs_cross(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
+    let p = abs(a);
+    let q = abs(b);
+    return vec3<f32>(p.y * q.z + p.z * q.y, p.z * q.x + p.x * q.z, p.x * q.y + p.y * q.x);
+}
+
+// The image's largest sample coordinates (`edge3d::image_extent`).
+fn extent() -> vec2<f32> {
+    return vec2<f32>(f32(P.size.x) + 1.0, f32(P.size.y) + 1.0);
+}
+
+// Is the f32 determinant `d` (error at most `bound`) of certain sign? If
+// not, the triangle `id` is listed for the CPU, whose setup takes the exact
+// sign (`edge3d::orientation`), and this returns false.
+fn oriented(id: u32, d: f32, bound: f32) -> bool {
+    if abs(d) > bound {
+        return true;
+    }
+    if finite(d) && finite(bound) {
+        cpu_list[atomicAdd(&counters[1], 1u)] = id;
+    }
+    return false;
+}
+
 // A 3D or homogeneous triangle from its linear edge functions (rows: A, B, C
-// per edge), `nd` and `volume` (`Triangle3D::from_linear`).
-fn linear_tri(id: u32, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, nd: vec3<f32>, volume: vec3<f32>, w: vec3<f32>, pbox: vec2<u32>) -> Tri {
+// per edge), `nd` and `volume`, and each edge's coefficient error over the
+// image (`Triangle3D::from_linear`, which adds the evaluation's rounding:
+// (A + x·B) + y·C rounds four times, by at most ε of the terms' magnitudes
+// each; both bounds doubled for margin).
+fn linear_tri(id: u32, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, nd: vec3<f32>, volume: vec3<f32>, w: vec3<f32>, coefficient_error: vec3<f32>, pbox: vec2<u32>) -> Tri {
     var t: Tri;
-    if !(finite3(a) && finite3(b) && finite3(c) && finite3(nd) && finite3(volume) && finite3(w)) || pbox.x == pbox.y {
+    let x = extent();
+    let tolerance = 2.0 * (coefficient_error + 4.0 * F32_EPS * (abs(a) + x.x * abs(b) + x.y * abs(c)));
+    if !(finite3(a) && finite3(b) && finite3(c) && finite3(nd) && finite3(volume) && finite3(w) && finite3(tolerance)) || pbox.x == pbox.y {
         return empty_tri();
     }
+    t.r[5] = vec4<f32>(tolerance, 0.0);
     t.r[0] = vec4<f32>(a, nd.x);
     t.r[1] = vec4<f32>(b, nd.y);
     t.r[2] = vec4<f32>(c, nd.z);
@@ -331,13 +374,18 @@ fn setup_3d(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) group
     var a: vec3<f32>;
     var b: vec3<f32>;
     var cc: vec3<f32>;
+    var error: vec3<f32>;
+    let x = extent();
     if P.mode.x == 0u {
         let d = dot3(normal, c[0]);
-        if d == 0.0 || !finite(d) {
+        if !oriented(l.id, d, 16.0 * F32_EPS * dot3(abs_cross(e1, e2), abs(c[0]))) {
             set_up(k, empty_tri());
             return;
         }
         let s = select(-1.0, 1.0, d > 0.0);
+        // Each edge's coefficients are within 8ε of |m| ⊗ |u| along the
+        // largest sample direction.
+        let d_abs = abs(P.d0.xyz) + abs(P.dx.xyz) * x.x + abs(P.dy.xyz) * x.y;
         for (var i = 0u; i < 3u; i++) {
             let p = c[(i + 1u) % 3u];
             let q = c[(i + 2u) % 3u];
@@ -345,16 +393,18 @@ fn setup_3d(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) group
             a[i] = e.x;
             b[i] = e.y;
             cc[i] = e.z;
+            error[i] = 8.0 * F32_EPS * dot3(abs_cross((p + q) * 0.5, p - q), d_abs);
         }
-        set_up(k, linear_tri(l.id, a, b, cc, along(normal * s), vec3<f32>(abs(d) * scale, 0.0, 0.0), w, pbox));
+        set_up(k, linear_tri(l.id, a, b, cc, along(normal * s), vec3<f32>(abs(d) * scale, 0.0, 0.0), w, error, pbox));
     } else {
         let dp = P.forward.xyz;
         let facing = dot3(normal, dp);
-        if facing == 0.0 || !finite(facing) {
+        if !oriented(l.id, facing, 16.0 * F32_EPS * dot3(abs_cross(e1, e2), abs(dp))) {
             set_up(k, empty_tri());
             return;
         }
         let s = select(-1.0, 1.0, facing > 0.0);
+        let o_abs = abs(P.o0.xyz * down) + abs(P.ox.xyz * down) * x.x + abs(P.oy.xyz * down) * x.y;
         for (var i = 0u; i < 3u; i++) {
             let p = c[(i + 1u) % 3u];
             let q = c[(i + 2u) % 3u];
@@ -363,10 +413,11 @@ fn setup_3d(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) group
             a[i] = dot3(n, m - P.o0.xyz * down);
             b[i] = -dot3(n, P.ox.xyz * down);
             cc[i] = -dot3(n, P.oy.xyz * down);
+            error[i] = 8.0 * F32_EPS * dot3(abs_cross(dp, p - q), abs(m) + o_abs);
         }
         let ns = normal * s;
         let volume = vec3<f32>(dot3(ns, c[0] - P.o0.xyz * down), -dot3(ns, P.ox.xyz * down), -dot3(ns, P.oy.xyz * down)) * scale;
-        set_up(k, linear_tri(l.id, a, b, cc, vec3<f32>(abs(facing), 0.0, 0.0), volume, w, pbox));
+        set_up(k, linear_tri(l.id, a, b, cc, vec3<f32>(abs(facing), 0.0, 0.0), volume, w, error, pbox));
     }
 }
 
@@ -398,9 +449,11 @@ fn setup_homogeneous(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgrou
         let q = h[(i + 2u) % 3u];
         rows[i] = cross3((p + q) * 0.5, q - p);
     }
-    let normal = cross3(h[1] - h[0], h[2] - h[0]);
+    let e1 = h[1] - h[0];
+    let e2 = h[2] - h[0];
+    let normal = cross3(e1, e2);
     let det = dot3(normal, h[0]);
-    if det == 0.0 || !finite(det) {
+    if !oriented(l.id, det, 16.0 * F32_EPS * dot3(abs_cross(e1, e2), abs(h[0]))) {
         set_up(k, empty_tri());
         return;
     }
@@ -419,7 +472,16 @@ fn setup_homogeneous(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgrou
         let r = rows[0] * w[0] + rows[1] * w[1] + rows[2] * w[2];
         volume = vec3<f32>(r.z * s, r.x * s, r.y * s);
     }
-    set_up(k, linear_tri(l.id, a, b, c, nd, volume, w, pbox));
+    // Each row's coefficients are within 6ε of |m| ⊗ |u| at (x, y, 1).
+    let x = extent();
+    var error: vec3<f32>;
+    for (var i = 0u; i < 3u; i++) {
+        let p = h[(i + 1u) % 3u];
+        let q = h[(i + 2u) % 3u];
+        let t = abs_cross((p + q) * 0.5, q - p);
+        error[i] = 6.0 * F32_EPS * (t.z + x.x * t.x + x.y * t.y);
+    }
+    set_up(k, linear_tri(l.id, a, b, c, nd, volume, w, error, pbox));
 }
 
 // Paper §3.1: project and set up 2D edge functions (`Triangle2D::setup`).
@@ -447,8 +509,7 @@ fn setup_2d(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) group
         v[i] = vec3<f32>(xy, select(1.0 / c.z, c.z, P.mode.x == 1u));
     }
     if clip {
-        let slot = atomicAdd(&counters[1], 1u);
-        clip_list[slot] = l.id;
+        cpu_list[atomicAdd(&counters[1], 1u)] = l.id;
         tris[k] = empty_tri();
         return;
     }
@@ -536,10 +597,50 @@ fn edges(t: Tri, x: f32, y: f32) -> vec3<f32> {
     );
 }
 
-fn covers(t: Tri, e: vec3<f32>) -> bool {
+const OUTSIDE: u32 = 0u;
+const INSIDE: u32 = 1u;
+const UNSURE: u32 = 2u;
+
+// Edge value `e` against its f32 error bound `tolerance`: certainly inside
+// or outside beyond it, unsure within it (the CPU decides exactly); with no
+// bound (2D) the f32 sign and the tie rule decide.
+fn edge_side(e: f32, tolerance: f32, owns: bool) -> u32 {
+    if e > tolerance {
+        return INSIDE;
+    }
+    if e < -tolerance {
+        return OUTSIDE;
+    }
+    if tolerance > 0.0 {
+        return UNSURE;
+    }
+    return select(OUTSIDE, INSIDE, inside_edge(e, owns));
+}
+
+// Whether a sample with edge values `e` is inside `t` (all three edges),
+// outside (some edge), or unsure (no edge outside, some unsure).
+fn covers(t: Tri, e: vec3<f32>) -> u32 {
     let flags = bitcast<u32>(t.r[6].w);
-    return inside_edge(e.x, (flags & 1u) != 0u) && inside_edge(e.y, (flags & 2u) != 0u)
-        && inside_edge(e.z, (flags & 4u) != 0u);
+    let sides = vec3<u32>(
+        edge_side(e.x, t.r[5].x, (flags & 1u) != 0u),
+        edge_side(e.y, t.r[5].y, (flags & 2u) != 0u),
+        edge_side(e.z, t.r[5].z, (flags & 4u) != 0u),
+    );
+    if any(sides == vec3<u32>(OUTSIDE)) {
+        return OUTSIDE;
+    }
+    return max(max(sides.x, sides.y), sides.z);
+}
+
+// Leaves sample `i` (layer-major index) of triangle `id` to the CPU's
+// exact decision (`ComputeSamples::unsure`). Past the list's capacity only
+// the count grows, and the host renders again with room for all.
+fn defer(id: u32, i: u32) {
+    let slot = atomicAdd(&counters[9], 1u);
+    if slot < P.flags.w {
+        cpu_list[2u * slot] = id;
+        cpu_list[2u * slot + 1u] = i;
+    }
 }
 
 // The sample's w (view-axis distance), or a negative value for none: 2D by
