@@ -4,8 +4,9 @@
 //! `2dr-brute` and `gpu-2dr-homogeneous` those of `2dr-homogeneous`, except
 //! at pixels the f64 explanation accounts for (a sample within 1e-3 pixel of
 //! an edge, at the near plane, or a depth tie — within 1e-5, or 1e-4 for the
-//! GPU's own rounding); the counts are printed per scene. (Run on Mesa's
-//! lavapipe in CI.)
+//! GPU's own rounding); the counts are printed per scene. The 3D and
+//! homogeneous kernels decide coverage exactly, so for them only depth ties
+//! may differ. (Run on Mesa's lavapipe in CI.)
 
 use std::collections::{BTreeMap, HashMap};
 
@@ -77,6 +78,13 @@ fn gpu_kernels_differ_from_their_cpu_family_only_where_explained() {
             r.explained(),
             r.covered
         );
+        // The 3D and homogeneous kernels decide coverage exactly (what f32
+        // cannot be sure of, the CPU decides): no pixel may differ at an
+        // edge, only where the driver's rounding of a depth decides (a
+        // depth tie, or a sample at the near plane).
+        if algorithm != AlgorithmId::Gpu2dr {
+            assert_eq!(r.edge, 0, "{}: coverage differs at an edge", cell.label());
+        }
         assert!(cell.output.stats.edge_evaluations > 0, "{}", cell.label());
         let total = per_scene
             .entry((cell.scene.to_string(), algorithm.as_str()))
@@ -257,4 +265,72 @@ fn gpu_kernels_refuse_what_they_cannot_render_by_field() {
     .expect_err("see-through");
     assert_eq!(e.field, "algorithm");
     assert_eq!(refused, PAIRS.len() * 6);
+}
+
+/// A grid with a vertex on every pixel centre: every sample lies on a vertex
+/// of six triangles, where f32 cannot decide any of them, so the kernels
+/// leave every sample to the CPU's exact decision — several per sample,
+/// far more than the room first made for them, so the render also runs
+/// again with room for all. The result must be the CPU's exactly: the same
+/// triangle at every pixel, and each sample inside the grid covered once.
+#[test]
+fn gpu_kernels_decide_exactly_where_f32_cannot() {
+    const N: u32 = 256;
+    // Under `exact_camera` at N×N pixels, pixel point (x, y) is world
+    // point (−1 + 2x/N, 1 − 2y/N, −1), exactly.
+    let at = |x: u32, y: u32| {
+        let s = 2.0 / N as f32;
+        glam::Vec3::new(
+            -1.0 + (x as f32 + 0.5) * s,
+            1.0 - (y as f32 + 0.5) * s,
+            -1.0,
+        )
+    };
+    let positions: Vec<glam::Vec3> = (0..N).flat_map(|y| (0..N).map(move |x| at(x, y))).collect();
+    let mut triangles = Vec::new();
+    for y in 0..N - 1 {
+        for x in 0..N - 1 {
+            let v = |dx: u32, dy: u32| (y + dy) * N + x + dx;
+            triangles.push([v(0, 0), v(0, 1), v(1, 0)]);
+            triangles.push([v(1, 0), v(0, 1), v(1, 1)]);
+        }
+    }
+    let scene = continuum_tests::scene_from_triangles(
+        positions,
+        triangles,
+        continuum_tests::exact_camera(),
+    );
+    let run = |algorithm| {
+        render(
+            &scene,
+            &RenderRequest::new(algorithm, scene.scene.first_camera(), N, N),
+        )
+        .unwrap_or_else(|e| panic!("{algorithm}: {e}"))
+    };
+    let mut checked = 0;
+    for (gpu, cpu) in &PAIRS[1..] {
+        let (g, c) = (run(*gpu), run(*cpu));
+        assert_eq!(
+            g.framebuffer.triangle_id, c.framebuffer.triangle_id,
+            "{gpu}: ids differ from {cpu}'s"
+        );
+        let interior = (1..N - 1).flat_map(|y| (1..N - 1).map(move |x| (y * N + x) as usize));
+        let not_once: Vec<usize> = interior
+            .filter(|&i| g.framebuffer.coverage_writes[i] != 1)
+            .collect();
+        assert!(
+            not_once.is_empty(),
+            "{gpu}: {} samples not covered once",
+            not_once.len()
+        );
+        // Each sample was unsure in about six triangles: past the first
+        // room of 2^16 pairs.
+        let exact = g.stats.counters.edge_tests_f64;
+        assert!(
+            exact > 1 << 17,
+            "{gpu}: only {exact} edge tests decided past f32"
+        );
+        checked += 1;
+    }
+    assert_eq!(checked, 3);
 }
