@@ -334,3 +334,40 @@ fn gpu_kernels_decide_exactly_where_f32_cannot() {
     }
     assert_eq!(checked, 3);
 }
+
+/// A scene whose set-up triangles would not fit the adapter's largest
+/// storage buffer (lavapipe: 128 MiB, 112 bytes per triangle) is an error
+/// naming `scene`, for every kernel, not a panic or a hang.
+#[test]
+fn gpu_kernels_refuse_a_scene_beyond_the_adapters_buffers() {
+    // 820 × 820 vertices: 1,341,954 triangles, 150 MB of set-up triangles.
+    const N: u32 = 820;
+    let positions: Vec<glam::Vec3> = (0..N)
+        .flat_map(|y| (0..N).map(move |x| glam::Vec3::new(x as f32, y as f32, -2000.0)))
+        .collect();
+    let mut triangles = Vec::new();
+    for y in 0..N - 1 {
+        for x in 0..N - 1 {
+            let v = |dx: u32, dy: u32| (y + dy) * N + x + dx;
+            triangles.push([v(0, 0), v(0, 1), v(1, 0)]);
+            triangles.push([v(1, 0), v(0, 1), v(1, 1)]);
+        }
+    }
+    assert!(triangles.len() as u64 * 112 > 128 << 20);
+    let scene = continuum_tests::scene_from_triangles(
+        positions,
+        triangles,
+        continuum_tests::exact_camera(),
+    );
+    let mut refused = 0;
+    for (gpu, _) in PAIRS {
+        let e = render(
+            &scene,
+            &RenderRequest::new(gpu, scene.scene.first_camera(), 64, 48),
+        )
+        .expect_err("beyond the buffers");
+        assert_eq!(e.field, "scene", "{gpu}: {e}");
+        refused += 1;
+    }
+    assert_eq!(refused, PAIRS.len());
+}
