@@ -1,8 +1,10 @@
 // `gpu-3dr-binned`: the sort-middle pipeline the paper's conclusion asks for
 // (Laine and Karras's bin → coarse → fine, with 3D edge functions). After the
-// 3D setup, every triangle's box is cut into 8×8-pixel tiles, each tile
-// tested against its three edges at the tile's corners (rejected, accepted
-// whole, or left to per-sample tests, as `3dr-bin` tests blocks); a pass
+// 3D setup, every triangle's box is cut into 64×64-pixel blocks and those
+// into 8×8-pixel tiles, hierarchically as `3dr-bin` refines its blocks: a
+// block is tested against the three edges at its corners (rejected, accepted
+// whole, or partly covered), the tiles of a partly covered one likewise,
+// and only a partly covered tile's samples are tested one by one; a pass
 // counts each tile's triangles, one workgroup turns the counts into offsets
 // (an exclusive prefix sum), a pass writes the lists, and one workgroup per
 // tile rasterizes its list with one thread per pixel, depth and id kept in
@@ -24,17 +26,20 @@ const PARTIAL: u32 = 1u;
 const ACCEPT: u32 = 2u;
 const ACCEPTED_BIT: u32 = 0x80000000u;
 
-// Where tile (tx, ty) stands against triangle t: its samples' box tested at
-// the corners where each edge is largest and smallest (the edge functions
-// are linear in the image point), with a margin of 2⁻²⁰ of the terms'
-// magnitudes for the f32 rounding of a corner against a sample, beyond the
-// edge's own tolerance: a tile is rejected or accepted only where every
-// sample's decision is certain (the exact one).
-fn tile_test(t: Tri, tx: u32, ty: u32) -> u32 {
-    let x0 = f32(tx * TILE) + P.span.x;
-    let y0 = f32(ty * TILE) + P.span.y;
-    let x1 = f32(min((tx + 1u) * TILE, P.size.x) - 1u) + P.span.z;
-    let y1 = f32(min((ty + 1u) * TILE, P.size.y) - 1u) + P.span.w;
+// Tiles per side of a block (64×64 pixels: the first level of the tests).
+const BLOCK: u32 = 8u;
+
+// Where the tiles [t0, t1] (inclusive, in tiles) stand against triangle t:
+// their samples' box tested at the corners where each edge is largest and
+// smallest (the edge functions are linear in the image point), with a
+// margin of 2⁻²⁰ of the terms' magnitudes for the f32 rounding of a corner
+// against a sample, beyond the edge's own tolerance: tiles are rejected or
+// accepted only where every sample's decision is certain (the exact one).
+fn tiles_test(t: Tri, t0: vec2<u32>, t1: vec2<u32>) -> u32 {
+    let x0 = f32(t0.x * TILE) + P.span.x;
+    let y0 = f32(t0.y * TILE) + P.span.y;
+    let x1 = f32(min((t1.x + 1u) * TILE, P.size.x) - 1u) + P.span.z;
+    let y1 = f32(min((t1.y + 1u) * TILE, P.size.y) - 1u) + P.span.w;
     var inside = true;
     for (var i = 0u; i < 3u; i++) {
         let a = t.r[0][i];
@@ -53,29 +58,34 @@ fn tile_test(t: Tri, tx: u32, ty: u32) -> u32 {
     return select(PARTIAL, ACCEPT, inside);
 }
 
-// Tile (tx, ty) against triangle k: pass 0 counts it in the tile's list,
-// pass 1 writes it there. Returns the tile test's outcome.
-fn bin_tile(t: Tri, k: u32, tx: u32, ty: u32) -> u32 {
-    let outcome = tile_test(t, tx, ty);
-    if outcome == REJECT {
-        return outcome;
+// Tile (tx, ty) against triangle k, in a block whose test said `block`:
+// tested unless the block was accepted whole; then pass 0 counts it in the
+// tile's list, pass 1 writes it there. Returns the tile's outcome, or
+// PARTIAL + ACCEPT (untested) for a tile of an accepted block.
+fn bin_tile(t: Tri, k: u32, tx: u32, ty: u32, block: u32) -> u32 {
+    var outcome = ACCEPT + PARTIAL;
+    if block != ACCEPT {
+        outcome = tiles_test(t, vec2<u32>(tx, ty), vec2<u32>(tx, ty));
+        if outcome == REJECT {
+            return outcome;
+        }
     }
     let tile = ty * P.mode.z + tx;
     if P.mode.y == 0u {
         atomicAdd(&tile_counts[tile], 1u);
     } else {
         let slot = tile_offsets[tile] + atomicAdd(&tile_cursor[tile], 1u);
-        tile_list[slot] = k | select(0u, ACCEPTED_BIT, outcome == ACCEPT);
+        tile_list[slot] = k | select(0u, ACCEPTED_BIT, outcome >= ACCEPT);
     }
     return outcome;
 }
 
-// The tile tests' totals (pass 0 only).
-fn count_tests(tested: u32, accepted: u32, rejected: u32) {
-    if P.mode.y == 0u && tested > 0u {
-        atomicAdd(&counters[2], tested);
-        atomicAdd(&counters[3], accepted);
-        atomicAdd(&counters[4], rejected);
+// The block and tile tests' totals (pass 0 only).
+fn count_tests(tests: Tests) {
+    if P.mode.y == 0u && tests.tested > 0u {
+        atomicAdd(&counters[2], tests.tested);
+        atomicAdd(&counters[3], tests.accepted);
+        atomicAdd(&counters[4], tests.rejected);
     }
 }
 
@@ -93,22 +103,60 @@ fn bin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) groups: ve
     if bitcast<u32>(t.r[6].x) == EMPTY || is_big(b) {
         return;
     }
-    var tested = 0u;
-    var accepted = 0u;
-    var rejected = 0u;
-    for (var ty = b.y / TILE; ty <= (b.w - 1u) / TILE; ty++) {
-        for (var tx = b.x / TILE; tx <= (b.z - 1u) / TILE; tx++) {
-            let outcome = bin_tile(t, k, tx, ty);
-            tested += 1u;
-            accepted += u32(outcome == ACCEPT);
-            rejected += u32(outcome == REJECT);
+    var tests = Tests(0u, 0u, 0u);
+    let first = vec2<u32>(b.x, b.y) / TILE;
+    let last = (vec2<u32>(b.z, b.w) - 1u) / TILE;
+    for (var by = first.y / BLOCK; by <= last.y / BLOCK; by++) {
+        for (var bx = first.x / BLOCK; bx <= last.x / BLOCK; bx++) {
+            let t0 = max(vec2<u32>(bx, by) * BLOCK, first);
+            let t1 = min(vec2<u32>(bx, by) * BLOCK + BLOCK - 1u, last);
+            let block = block_test(t, t0, t1, &tests);
+            if block == REJECT {
+                continue;
+            }
+            for (var ty = t0.y; ty <= t1.y; ty++) {
+                for (var tx = t0.x; tx <= t1.x; tx++) {
+                    count(&tests, bin_tile(t, k, tx, ty, block));
+                }
+            }
         }
     }
-    count_tests(tested, accepted, rejected);
+    count_tests(tests);
 }
 
-// A big triangle's tiles: one workgroup per 8×8 tiles of its box and big
-// triangle, one thread per tile.
+// Tests made: tested, accepted whole, rejected.
+struct Tests {
+    tested: u32,
+    accepted: u32,
+    rejected: u32,
+}
+
+// Counts an outcome of a test (not the untested tiles of an accepted block).
+fn count(tests: ptr<function, Tests>, outcome: u32) {
+    if outcome <= ACCEPT {
+        (*tests).tested += 1u;
+        (*tests).accepted += u32(outcome == ACCEPT);
+        (*tests).rejected += u32(outcome == REJECT);
+    }
+}
+
+// The first level: the block of tiles [t0, t1] tested whole when it holds
+// at least 4×4 of them (a test that decides then saves 16 or more; the
+// few tiles of a small triangle's box are tested one by one). Counted in
+// `tests`.
+fn block_test(t: Tri, t0: vec2<u32>, t1: vec2<u32>, tests: ptr<function, Tests>) -> u32 {
+    let n = t1 - t0 + 1u;
+    if n.x * n.y < 16u {
+        return PARTIAL;
+    }
+    let outcome = tiles_test(t, t0, t1);
+    count(tests, outcome);
+    return outcome;
+}
+
+// A big triangle's tiles: one workgroup per block of 8×8 tiles of its box
+// and big triangle, one thread per tile; each thread makes the block's test
+// (the first thread counts it), then its tile's unless the block decided.
 @compute @workgroup_size(8, 8)
 fn bin_big(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
     let k = big_triangle(wg.y);
@@ -117,12 +165,21 @@ fn bin_big(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_id) l
     }
     let t = tris[k];
     let b = box_of(t);
-    let tile = chunk_tile(b, wg.x, lid.xy);
-    if tile.x > (b.z - 1u) / TILE || tile.y > (b.w - 1u) / TILE {
+    let last = (vec2<u32>(b.z, b.w) - 1u) / TILE;
+    let t0 = chunk_tile(b, wg.x, vec2<u32>(0u));
+    if t0.x > last.x || t0.y > last.y {
         return;
     }
-    let outcome = bin_tile(t, k, tile.x, tile.y);
-    count_tests(1u, u32(outcome == ACCEPT), u32(outcome == REJECT));
+    var tests = Tests(0u, 0u, 0u);
+    let block = block_test(t, t0, min(t0 + BLOCK - 1u, last), &tests);
+    if any(lid.xy != vec2<u32>(0u)) {
+        tests = Tests(0u, 0u, 0u);
+    }
+    let tile = chunk_tile(b, wg.x, lid.xy);
+    if block != REJECT && tile.x <= last.x && tile.y <= last.y {
+        count(&tests, bin_tile(t, k, tile.x, tile.y, block));
+    }
+    count_tests(tests);
 }
 
 var<workgroup> partial: array<u32, 256>;
