@@ -1104,3 +1104,82 @@ fn help_lists_every_value_and_marks_required_flags() {
         "{usage}"
     );
 }
+
+/// The paper's §5 experiment (`docker/gpu-sect5.toml`) at a small size: the
+/// compute kernels side by side with the depth test off and on, every one
+/// agreeing with its reference (`3dr-brute` with the depth test, `gpu-3dr`
+/// without), and the §5 table printed and in the report.
+#[test]
+fn the_section_5_sweep_sets_the_gpu_kernels_side_by_side_in_agreement() {
+    let base = out_dir("sect5");
+    let repo = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let paper =
+        std::fs::read_to_string(repo.join("docker/gpu-sect5.toml")).expect("gpu-sect5.toml");
+    let sweep: toml::Table = toml::from_str(&paper).expect("gpu-sect5.toml parses");
+    let scenes: Vec<String> = sweep["scenes"]
+        .as_array()
+        .expect("scenes")
+        .iter()
+        .map(|s| {
+            repo.join(s.as_str().expect("scene path"))
+                .display()
+                .to_string()
+        })
+        .collect();
+    let algorithms = &sweep["algorithms"];
+    let small = format!(
+        "scenes = {scenes:?}\nalgorithms = {algorithms}\nsize = \"160x100\"\nrepeat = 1\ndepth_test = [false, true]\n"
+    );
+    let file = base.join("sect5.toml");
+    std::fs::write(&file, small).expect("sweep file");
+    let dir = base.join("out");
+    let out = continuum(&[
+        "compare",
+        "--sweep",
+        file.to_str().expect("utf-8"),
+        "--out",
+        dir.to_str().expect("utf-8"),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let results = results_json(&dir);
+    let rows = results["rows"].as_array().expect("rows");
+    let kernels = [
+        "gpu-2dr",
+        "gpu-2dr-homogeneous",
+        "gpu-3dr",
+        "gpu-3dr-binned",
+    ];
+    let mut checked = 0;
+    for r in rows {
+        let algorithm = r["algorithm"].as_str().expect("algorithm");
+        if kernels.contains(&algorithm) {
+            assert_eq!(
+                r["agrees"], true,
+                "{algorithm} depth_test {}: {r}",
+                r["depth_test"]
+            );
+            checked += 1;
+        }
+    }
+    // Two scenes, the depth test off and on; gpu-raster (on only) and
+    // 3dr-brute (on only) beside the four kernels.
+    assert_eq!(checked, 2 * 2 * kernels.len(), "kernel rows");
+    assert_eq!(rows.len(), 2 * (kernels.len() * 2 + 2), "rows");
+    let title = stdout
+        .find("GPU shaders side by side")
+        .expect("the section 5 table");
+    // One line per scene and depth test setting.
+    let table = stdout[title..].lines().filter(|l| l.contains("160x100"));
+    assert_eq!(table.count(), 4, "{stdout}");
+    let html = std::fs::read_to_string(dir.join("report.html")).expect("report.html");
+    assert!(
+        html.contains("id=\"sect5\""),
+        "report lacks the section 5 table"
+    );
+    std::fs::remove_dir_all(&base).ok();
+}

@@ -311,11 +311,13 @@ fn algorithm_row(
 
 /// Family agreement (the first member of each family in the cell is its
 /// reference) and, for the peers and the GPU, the pixels differing from
-/// `3dr-brute`.
+/// `3dr-brute`. A cell without `3dr-brute` (the depth test off, which only
+/// the compute kernels offer) holds the GPU rows to `gpu-3dr`'s ids
+/// instead: agreement only, no pixel count.
 fn relate_in_cell(rows: &mut [Measured]) {
-    let three_d = rows
-        .iter()
-        .position(|m| m.row.algorithm == AlgorithmId::ThreeDBrute.as_str());
+    let position = |a: AlgorithmId| rows.iter().position(|m| m.row.algorithm == a.as_str());
+    let three_d = position(AlgorithmId::ThreeDBrute);
+    let reference = three_d.or(position(AlgorithmId::Gpu3dr));
     let mut family_reference: HashMap<String, usize> = HashMap::new();
     for i in 0..rows.len() {
         let cpu = AlgorithmId::CPU
@@ -328,14 +330,16 @@ fn relate_in_cell(rows: &mut [Measured]) {
                 rows[i].row.agrees = rows[i].keys == rows[reference].keys;
             }
             None => {
-                if let Some(j) = three_d {
+                if let Some(j) = reference {
                     let differing = rows[j]
                         .keys
                         .iter()
                         .zip(&rows[i].keys)
                         .filter(|(a, b)| a != b)
                         .count() as u64;
-                    rows[i].row.pixels_differing_from_3dr_brute = Some(differing);
+                    if three_d.is_some() {
+                        rows[i].row.pixels_differing_from_3dr_brute = Some(differing);
+                    }
                     rows[i].row.agrees = differing == 0;
                 }
             }

@@ -518,7 +518,7 @@ fn traversal(h: &mut String, rows: &[Row]) {
 /// Does every algorithm agree with its family (continuum's own: bit for bit)?
 fn agreement(h: &mut String, rows: &[Row]) {
     let algorithms = distinct(rows.iter().map(|r| r.algorithm.as_str()));
-    h.push_str("<h2 id=\"agreement\">Agreement</h2>\n<p>✓: the triangle ids (per sample with anti-aliasing) equal the family's first member's bit for bit; for peers and gpu-raster, equal 3dr-brute's. A ✗ on one of continuum's own algorithms is a bug.</p>\n<table><tr><th class=\"l\">scene / viewport / aa / precision</th>");
+    h.push_str("<h2 id=\"agreement\">Agreement</h2>\n<p>✓: the triangle ids (per sample with anti-aliasing) equal the family's first member's bit for bit; for peers and the GPU, equal 3dr-brute's (with no depth test, which only the compute kernels offer, gpu-3dr's). A ✗ on one of continuum's own algorithms is a bug.</p>\n<table><tr><th class=\"l\">scene / viewport / aa / precision</th>");
     for a in &algorithms {
         let _ = write!(h, "<th>{}</th>", escape(a));
     }
@@ -527,11 +527,12 @@ fn agreement(h: &mut String, rows: &[Row]) {
         let f = group[0];
         let _ = write!(
             h,
-            "<tr><td class=\"l\">{} / {} / {} / {}</td>",
+            "<tr><td class=\"l\">{} / {} / {} / {}{}</td>",
             escape(&f.scene),
             escape(&f.viewport),
             escape(&f.aa),
-            f.precision
+            f.precision,
+            if f.depth_test { "" } else { " / no depth test" }
         );
         for a in &algorithms {
             match group.iter().find(|r| r.algorithm == *a) {
