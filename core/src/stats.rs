@@ -152,6 +152,10 @@ pub struct RasterCounters {
     pub nodes_culled_outside: u64,
     /// BVH nodes culled because the hierarchical w-buffer hides them.
     pub nodes_culled_occluded: u64,
+    /// Leaf triangles a frustum reached that an earlier frustum of the same
+    /// work item had set up already (their setup reused, not counted again
+    /// in `triangle_setups`).
+    pub leaf_setups_reused: u64,
     /// Runs of pixels (one per pixel row a triangle reaches) that the span
     /// traversal (`2dr-scanline`) found covered.
     pub spans: u64,
@@ -177,6 +181,7 @@ impl std::ops::AddAssign for RasterCounters {
         self.frusta_split += o.frusta_split;
         self.nodes_culled_outside += o.nodes_culled_outside;
         self.nodes_culled_occluded += o.nodes_culled_occluded;
+        self.leaf_setups_reused += o.leaf_setups_reused;
         self.spans += o.spans;
         self.edge_steps += o.edge_steps;
         self.edge_tests_f64 += o.edge_tests_f64;

@@ -13,6 +13,7 @@
 //! same image as `3dr-brute`.
 
 use glam::{Vec3, Vec3A};
+use rustc_hash::FxHashMap;
 
 use crate::binning::raster_triangle;
 use crate::bvh::{SlabRay, padded};
@@ -30,6 +31,34 @@ use crate::trace::{FrustumEvent, NodeOutcome};
 /// result may borrow both.
 pub(crate) type Setup<'a, T> = fn(&'a [Vec3; 3], &'a View) -> Option<T>;
 
+/// A leaf triangle as the frusta of one work item met it: its screen box
+/// (`None`: no sample on screen), and its setup once a frustum needed it
+/// (`Some(None)`: set up, but seen edge-on).
+#[derive(Clone, Copy, Debug)]
+struct Leaf<T> {
+    rect: Option<PixelRect>,
+    tri: Option<Option<T>>,
+}
+
+/// The leaf triangles the frusta of one work item have reached, by BVH
+/// slot: each triangle's box is made and its setup done once, however many
+/// of the Fig. 7 frusta reach it (a 256² frustum split down to 8² reaches a
+/// leaf from every sub-frustum its box overlaps). Lazy — a triangle no
+/// frustum reaches costs nothing — and kept by the worker, emptied (not
+/// freed) for its next work item.
+#[derive(Debug)]
+pub(crate) struct LeafCache<T> {
+    leaves: FxHashMap<u32, Leaf<T>>,
+}
+
+impl<T> Default for LeafCache<T> {
+    fn default() -> Self {
+        LeafCache {
+            leaves: FxHashMap::default(),
+        }
+    }
+}
+
 /// Per-frustum traversal state and counters.
 pub(crate) struct Traversal<'a, 't, T> {
     pub scene: &'a PreparedScene,
@@ -39,6 +68,8 @@ pub(crate) struct Traversal<'a, 't, T> {
     pub setup: Setup<'a, T>,
     /// The leaf triangles' screen boxes.
     pub boxes: &'t ScreenBoxes,
+    /// The leaf triangles this work item has set up.
+    leaves: &'t mut LeafCache<T>,
     pub counters: RasterCounters,
     pub nodes_visited: u64,
     pub setups: u64,
@@ -109,17 +140,18 @@ impl Frustum {
     }
 }
 
-impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
+impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
     /// A traversal of the frustum over `tile`'s pixels, leaf triangles set up
-    /// by `setup` over their `boxes`.
+    /// by `setup` over their `boxes`, once each in `leaves` (emptied first).
     pub fn new(
         scene: &'a PreparedScene,
         view: &'a View,
         oracles: TraversalOracles,
         tile: &'t mut TileBuffer<'a>,
-        setup: Setup<'a, T>,
-        boxes: &'t ScreenBoxes,
+        (setup, boxes): (Setup<'a, T>, &'t ScreenBoxes),
+        leaves: &'t mut LeafCache<T>,
     ) -> Self {
+        leaves.leaves.clear();
         Traversal {
             scene,
             view,
@@ -127,6 +159,7 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
             tile,
             setup,
             boxes,
+            leaves,
             counters: RasterCounters::default(),
             nodes_visited: 0,
             setups: 0,
@@ -295,26 +328,37 @@ impl<'a, 't, T: Coverage> Traversal<'a, 't, T> {
         extent < w.max(h) as f32 * 0.5
     }
 
-    /// Sets up the leaf's triangles and rasterizes them over the frustum.
+    /// Sets up the leaf's triangles (those this work item has not yet) and
+    /// rasterizes them over the frustum.
     fn rasterize_leaf(&mut self, f: PixelRect, start: u32, count: u32) {
         let scene = self.scene;
         self.tile
             .record(|t| t.frusta.push((f, FrustumEvent::Rasterized)));
-        for slot in start as usize..(start + count) as usize {
+        let (view, boxes, span) = (self.view, self.boxes, self.tile.pattern.span);
+        for slot in start..start + count {
             // The slot-ordered copies: a leaf's triangles sit side by side.
-            let (p, id) = (&scene.slot_corners[slot], scene.slot_triangles[slot]);
-            let vertices = scene.slot_vertices[slot];
-            let span = self.tile.pattern.span;
-            let Some(rect) = self.boxes.rect(p, vertices, self.view, span) else {
+            let p = &scene.slot_corners[slot as usize];
+            let leaf = self.leaves.leaves.entry(slot).or_insert_with(|| Leaf {
+                rect: boxes.rect(p, scene.slot_vertices[slot as usize], view, span),
+                tri: None,
+            });
+            let Some(clip) = leaf.rect.and_then(|rect| rect.intersect(f)) else {
                 continue;
             };
-            let Some(clip) = rect.intersect(f) else {
+            let tri = match leaf.tri {
+                Some(tri) => {
+                    self.counters.leaf_setups_reused += 1;
+                    tri
+                }
+                None => {
+                    self.setups += 1;
+                    *leaf.tri.insert((self.setup)(p, view))
+                }
+            };
+            let Some(tri) = tri else {
                 continue;
             };
-            self.setups += 1;
-            let Some(tri) = (self.setup)(p, self.view) else {
-                continue;
-            };
+            let id = scene.slot_triangles[slot as usize];
             raster_triangle(
                 self.tile,
                 &tri,

@@ -543,11 +543,14 @@ fn compare_measures_each_thread_count() {
     let header = lines.next().expect("a header");
     let column = |name: &str| header.iter().position(|h| *h == name).expect(name);
     let (visited, outside) = (column("bvh_nodes_visited"), column("nodes_culled_outside"));
+    let reused = column("leaf_setups_reused");
     let full: Vec<_> = lines.filter(|l| l[1] == "3dr-full").collect();
     assert_eq!(full.len(), 2, "{csv}");
     for l in full {
         let n = |i: usize| l[i].parse::<u64>().expect("a count");
         assert!(n(visited) > 0 && n(outside) <= n(visited), "{l:?}");
+        // The box's faces span many of the 8x8 frusta: set up once each.
+        assert!(n(reused) > 0, "{l:?}");
     }
     let bad = continuum(&["compare", "--threads", "0,2", "--out", "/tmp/never"]);
     assert_eq!(bad.status.code(), Some(2));

@@ -42,7 +42,7 @@ use crate::screen_boxes::ScreenBoxes;
 use crate::shade::Shader;
 use crate::stats::{CoverageHistogram, RasterCounters, Stats};
 use crate::trace::Trace;
-use crate::traversal::{Setup, Traversal};
+use crate::traversal::{LeafCache, Setup, Traversal};
 use tiles::rasterize_tiled;
 
 /// Renders `view` of `scene` with `pipeline` at `precision` into `fb`: the
@@ -186,7 +186,7 @@ fn compute(
 
 /// The Fig. 7 traversal, one initial frustum per parallel work item, leaf
 /// triangles set up by `setup`.
-fn render_frusta<'a, T: crate::edge::Coverage>(
+fn render_frusta<'a, T: crate::edge::Coverage + Copy>(
     scene: &'a PreparedScene,
     context: &TileContext<'a>,
     oracles: TraversalOracles,
@@ -203,10 +203,11 @@ fn render_frusta<'a, T: crate::edge::Coverage>(
         .planes(fb, &rects)
         .into_par_iter()
         .map_init(
-            || None,
-            |cache, planes| {
+            || (None, LeafCache::default()),
+            |(cache, leaves), planes| {
                 context.run_tile(cache, planes, |tile| {
-                    let mut t = Traversal::new(scene, context.view, oracles, tile, setup, boxes);
+                    let how = (setup, boxes);
+                    let mut t = Traversal::new(scene, context.view, oracles, tile, how, leaves);
                     t.run();
                     (t.counters, t.nodes_visited, t.setups)
                 })

@@ -494,13 +494,13 @@ fn traversal(h: &mut String, rows: &[Row]) {
     if !rows.iter().any(|r| walks(&r)) {
         return;
     }
-    h.push_str("<h2 id=\"traversal\">BVH traversal</h2>\n<p>Per row: the nodes visited (a culled node counts once, its subtree not at all), those culled as outside the frustum and as occluded behind the hierarchical w-buffer (<em>culled</em> share of the visits in brackets), the frusta split and the leaf triangles set up. <code>raycast</code> counts the nodes its packets entered.</p>\n<table><tr><th class=\"l\">scene</th><th class=\"l\">algorithm</th><th class=\"l\">viewport</th><th class=\"l\">aa</th><th>median ms</th><th>nodes visited</th><th>outside</th><th>occluded</th><th>frusta split</th><th>setups</th></tr>\n");
+    h.push_str("<h2 id=\"traversal\">BVH traversal</h2>\n<p>Per row: the nodes visited (a culled node counts once, its subtree not at all), those culled as outside the frustum and as occluded behind the hierarchical w-buffer (<em>culled</em> share of the visits in brackets), the frusta split, the leaf triangles set up, and the setups reused (a leaf triangle reached again by another frustum of the same work item). <code>raycast</code> counts the nodes its packets entered.</p>\n<table><tr><th class=\"l\">scene</th><th class=\"l\">algorithm</th><th class=\"l\">viewport</th><th class=\"l\">aa</th><th>median ms</th><th>nodes visited</th><th>outside</th><th>occluded</th><th>frusta split</th><th>setups</th><th>reused</th></tr>\n");
     for r in rows.iter().filter(walks) {
         let visited = count(r, "bvh_nodes_visited");
         let share = |n: u64| format!("{n} ({:.0}%)", 100.0 * n as f64 / visited as f64);
         let _ = writeln!(
             h,
-            "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{:.2}</td><td>{visited}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            "<tr><td class=\"l\">{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td class=\"l\">{}</td><td>{:.2}</td><td>{visited}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             escape(&r.scene),
             escape(&r.algorithm),
             escape(&r.viewport),
@@ -510,6 +510,7 @@ fn traversal(h: &mut String, rows: &[Row]) {
             share(count(r, "nodes_culled_occluded")),
             count(r, "frusta_split"),
             count(r, "triangle_setups"),
+            count(r, "leaf_setups_reused"),
         );
     }
     h.push_str("</table>\n");
