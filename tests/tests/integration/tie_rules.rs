@@ -102,10 +102,15 @@ fn fan_around_a_vertex_on_a_pixel_centre_covers_each_pixel_once() {
         }
         // The centre vertex lies exactly on a pixel centre's ray: the 3D and
         // homogeneous families decide their edges there past f32, some
-        // exactly, and count them (README: "Precision and exactness"); the
-        // 2D family and the GPU have no such path.
+        // exactly, and count them (README: "Precision and exactness"), the
+        // GPU kernels of those families through the CPU; the 2D family,
+        // `gpu-2dr` and `gpu-raster` have no such path.
         let c = &out.stats.counters;
-        if matches!(algorithm.family(), Family::ThreeD | Family::Homogeneous) {
+        let exact_gpu = matches!(
+            algorithm,
+            AlgorithmId::Gpu2drHomogeneous | AlgorithmId::Gpu3dr | AlgorithmId::Gpu3drBinned
+        );
+        if exact_gpu || matches!(algorithm.family(), Family::ThreeD | Family::Homogeneous) {
             three_d += 1;
             assert!(c.edge_tests_exact > 0, "{algorithm}: {c:?}");
             assert!(c.edge_tests_f64 >= c.edge_tests_exact, "{algorithm}: {c:?}");
@@ -119,7 +124,7 @@ fn fan_around_a_vertex_on_a_pixel_centre_covers_each_pixel_once() {
     });
     assert_eq!(rendered, AlgorithmId::ALL.len());
     assert_eq!(
-        three_d, 7,
-        "2dr-homogeneous, the five 3D rasterizers and raycast"
+        three_d, 10,
+        "2dr-homogeneous, the five 3D rasterizers, raycast and three GPU kernels"
     );
 }
