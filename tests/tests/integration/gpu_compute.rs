@@ -286,20 +286,7 @@ fn gpu_kernels_decide_exactly_where_f32_cannot() {
             -1.0,
         )
     };
-    let positions: Vec<glam::Vec3> = (0..N).flat_map(|y| (0..N).map(move |x| at(x, y))).collect();
-    let mut triangles = Vec::new();
-    for y in 0..N - 1 {
-        for x in 0..N - 1 {
-            let v = |dx: u32, dy: u32| (y + dy) * N + x + dx;
-            triangles.push([v(0, 0), v(0, 1), v(1, 0)]);
-            triangles.push([v(1, 0), v(0, 1), v(1, 1)]);
-        }
-    }
-    let scene = continuum_tests::scene_from_triangles(
-        positions,
-        triangles,
-        continuum_tests::exact_camera(),
-    );
+    let scene = grid_scene(N, at);
     let run = |algorithm| {
         render(
             &scene,
@@ -342,23 +329,8 @@ fn gpu_kernels_decide_exactly_where_f32_cannot() {
 fn gpu_kernels_refuse_a_scene_beyond_the_adapters_buffers() {
     // 820 × 820 vertices: 1,341,954 triangles, 150 MB of set-up triangles.
     const N: u32 = 820;
-    let positions: Vec<glam::Vec3> = (0..N)
-        .flat_map(|y| (0..N).map(move |x| glam::Vec3::new(x as f32, y as f32, -2000.0)))
-        .collect();
-    let mut triangles = Vec::new();
-    for y in 0..N - 1 {
-        for x in 0..N - 1 {
-            let v = |dx: u32, dy: u32| (y + dy) * N + x + dx;
-            triangles.push([v(0, 0), v(0, 1), v(1, 0)]);
-            triangles.push([v(1, 0), v(0, 1), v(1, 1)]);
-        }
-    }
-    assert!(triangles.len() as u64 * 112 > 128 << 20);
-    let scene = continuum_tests::scene_from_triangles(
-        positions,
-        triangles,
-        continuum_tests::exact_camera(),
-    );
+    let scene = grid_scene(N, |x, y| glam::Vec3::new(x as f32, y as f32, -2000.0));
+    assert!(scene.triangle_count() as u64 * 112 > 128 << 20);
     let mut refused = 0;
     for (gpu, _) in PAIRS {
         let e = render(
@@ -370,4 +342,20 @@ fn gpu_kernels_refuse_a_scene_beyond_the_adapters_buffers() {
         refused += 1;
     }
     assert_eq!(refused, PAIRS.len());
+}
+
+/// A grid of `n` × `n` vertices at `at(x, y)`, two triangles per cell, seen
+/// by `exact_camera`.
+fn grid_scene(n: u32, at: impl Fn(u32, u32) -> glam::Vec3) -> continuum::PreparedScene {
+    let positions = (0..n).flat_map(|y| (0..n).map(move |x| (x, y)));
+    let positions = positions.map(|(x, y)| at(x, y)).collect();
+    let mut triangles = Vec::new();
+    for y in 0..n - 1 {
+        for x in 0..n - 1 {
+            let v = |dx: u32, dy: u32| (y + dy) * n + x + dx;
+            triangles.push([v(0, 0), v(0, 1), v(1, 0)]);
+            triangles.push([v(1, 0), v(0, 1), v(1, 1)]);
+        }
+    }
+    continuum_tests::scene_from_triangles(positions, triangles, continuum_tests::exact_camera())
 }
