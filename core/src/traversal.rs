@@ -13,7 +13,6 @@
 //! same image as `3dr-brute`.
 
 use glam::{Vec3, Vec3A};
-use rustc_hash::FxHashMap;
 
 use crate::binning::raster_triangle;
 use crate::bvh::{SlabRay, padded};
@@ -40,21 +39,27 @@ struct Leaf<T> {
     tri: Option<Option<T>>,
 }
 
-/// The leaf triangles the frusta of one work item have reached, by BVH
-/// slot: each triangle's box is made and its setup done once, however many
-/// of the Fig. 7 frusta reach it (a 256² frustum split down to 8² reaches a
-/// leaf from every sub-frustum its box overlaps). Lazy — a triangle no
-/// frustum reaches costs nothing — and kept by the worker, emptied (not
-/// freed) for its next work item.
+/// The leaf triangles the frusta of one work item reached last, by BVH
+/// slot: a triangle's box is made and its setup done once while it stays
+/// here, however many of the Fig. 7 frusta reach it (a 256² frustum split
+/// down to 8² reaches a leaf from every sub-frustum its box overlaps, one
+/// after the other). Direct-mapped on the slot's low bits — a leaf's
+/// triangles and its neighbours' have consecutive slots, so they do not
+/// evict each other — and small enough to stay in cache beside the tile
+/// (a map of every triangle reached cost more than the setups it saved on
+/// a million small triangles). Kept by the worker, emptied per work item.
 #[derive(Debug)]
 pub(crate) struct LeafCache<T> {
-    leaves: FxHashMap<u32, Leaf<T>>,
+    leaves: Vec<Option<(u32, Leaf<T>)>>,
 }
 
-impl<T> Default for LeafCache<T> {
+/// Entries of a [`LeafCache`] (a power of two).
+const LEAF_CACHE: usize = 1024;
+
+impl<T: Copy> Default for LeafCache<T> {
     fn default() -> Self {
         LeafCache {
-            leaves: FxHashMap::default(),
+            leaves: vec![None; LEAF_CACHE],
         }
     }
 }
@@ -151,7 +156,7 @@ impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
         (setup, boxes): (Setup<'a, T>, &'t ScreenBoxes),
         leaves: &'t mut LeafCache<T>,
     ) -> Self {
-        leaves.leaves.clear();
+        leaves.leaves.fill(None);
         Traversal {
             scene,
             view,
@@ -338,10 +343,17 @@ impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
         for slot in start..start + count {
             // The slot-ordered copies: a leaf's triangles sit side by side.
             let p = &scene.slot_corners[slot as usize];
-            let leaf = self.leaves.leaves.entry(slot).or_insert_with(|| Leaf {
-                rect: boxes.rect(p, scene.slot_vertices[slot as usize], view, span),
-                tri: None,
-            });
+            let entry = &mut self.leaves.leaves[slot as usize % LEAF_CACHE];
+            let (_, leaf) = match entry {
+                Some((s, _)) if *s == slot => entry.as_mut().expect("matched"),
+                _ => entry.insert((
+                    slot,
+                    Leaf {
+                        rect: boxes.rect(p, scene.slot_vertices[slot as usize], view, span),
+                        tri: None,
+                    },
+                )),
+            };
             let Some(clip) = leaf.rect.and_then(|rect| rect.intersect(f)) else {
                 continue;
             };
