@@ -153,8 +153,8 @@ pub struct RasterCounters {
     /// BVH nodes culled because the hierarchical w-buffer hides them.
     pub nodes_culled_occluded: u64,
     /// Leaf triangles a frustum reached that an earlier frustum of the same
-    /// work item had set up already (their setup reused, not counted again
-    /// in `triangle_setups`).
+    /// work item had set up and the worker's leaf cache still held (their
+    /// setup reused, not counted again in `triangle_setups`).
     pub leaf_setups_reused: u64,
     /// Runs of pixels (one per pixel row a triangle reaches) that the span
     /// traversal (`2dr-scanline`) found covered.

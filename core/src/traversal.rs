@@ -73,7 +73,7 @@ pub(crate) struct Traversal<'a, 't, T> {
     pub setup: Setup<'a, T>,
     /// The leaf triangles' screen boxes.
     pub boxes: &'t ScreenBoxes,
-    /// The leaf triangles this work item has set up.
+    /// The leaf triangles this work item set up last.
     leaves: &'t mut LeafCache<T>,
     pub counters: RasterCounters,
     pub nodes_visited: u64,
