@@ -30,13 +30,22 @@ use crate::trace::{FrustumEvent, NodeOutcome};
 /// result may borrow both.
 pub(crate) type Setup<'a, T> = fn(&'a [Vec3; 3], &'a View) -> Option<T>;
 
-/// A leaf triangle as the frusta of one work item met it: its screen box
-/// (`None`: no sample on screen), and its setup once a frustum needed it
-/// (`Some(None)`: set up, but seen edge-on).
+/// A leaf triangle as the frusta of one work item met it: its BVH slot
+/// (`u32::MAX`: none), its screen box (`None`: no sample on screen), and its
+/// setup once a frustum needed it (`Some(None)`: set up, but seen edge-on).
 #[derive(Clone, Copy, Debug)]
 struct Leaf<T> {
+    slot: u32,
     rect: Option<PixelRect>,
     tri: Option<Option<T>>,
+}
+
+impl<T> Leaf<T> {
+    const EMPTY: Leaf<T> = Leaf {
+        slot: u32::MAX,
+        rect: None,
+        tri: None,
+    };
 }
 
 /// The leaf triangles the frusta of one work item reached last, by BVH
@@ -50,7 +59,7 @@ struct Leaf<T> {
 /// a million small triangles). Kept by the worker, emptied per work item.
 #[derive(Debug)]
 pub(crate) struct LeafCache<T> {
-    leaves: Vec<Option<(u32, Leaf<T>)>>,
+    leaves: Vec<Leaf<T>>,
 }
 
 /// Entries of a [`LeafCache`] (a power of two).
@@ -59,7 +68,7 @@ const LEAF_CACHE: usize = 1024;
 impl<T: Copy> Default for LeafCache<T> {
     fn default() -> Self {
         LeafCache {
-            leaves: vec![None; LEAF_CACHE],
+            leaves: vec![Leaf::EMPTY; LEAF_CACHE],
         }
     }
 }
@@ -156,7 +165,7 @@ impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
         (setup, boxes): (Setup<'a, T>, &'t ScreenBoxes),
         leaves: &'t mut LeafCache<T>,
     ) -> Self {
-        leaves.leaves.fill(None);
+        leaves.leaves.fill(Leaf::EMPTY);
         Traversal {
             scene,
             view,
@@ -333,7 +342,7 @@ impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
         extent < w.max(h) as f32 * 0.5
     }
 
-    /// Sets up the leaf's triangles (those this work item has not yet) and
+    /// Sets up the leaf's triangles (those the leaf cache does not hold) and
     /// rasterizes them over the frustum.
     fn rasterize_leaf(&mut self, f: PixelRect, start: u32, count: u32) {
         let scene = self.scene;
@@ -343,17 +352,14 @@ impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
         for slot in start..start + count {
             // The slot-ordered copies: a leaf's triangles sit side by side.
             let p = &scene.slot_corners[slot as usize];
-            let entry = &mut self.leaves.leaves[slot as usize % LEAF_CACHE];
-            let (_, leaf) = match entry {
-                Some((s, _)) if *s == slot => entry.as_mut().expect("matched"),
-                _ => entry.insert((
+            let leaf = &mut self.leaves.leaves[slot as usize % LEAF_CACHE];
+            if leaf.slot != slot {
+                *leaf = Leaf {
                     slot,
-                    Leaf {
-                        rect: boxes.rect(p, scene.slot_vertices[slot as usize], view, span),
-                        tri: None,
-                    },
-                )),
-            };
+                    rect: boxes.rect(p, scene.slot_vertices[slot as usize], view, span),
+                    tri: None,
+                };
+            }
             let Some(clip) = leaf.rect.and_then(|rect| rect.intersect(f)) else {
                 continue;
             };

@@ -29,7 +29,7 @@ use super::{Pass, TileContext, setup2d};
 use crate::aa::SamplePattern;
 use crate::camera::View;
 use crate::edge::{Coverage, HomogeneousVertex, Triangle3D, setup_homogeneous_from};
-use crate::framebuffer::{BACKGROUND, Framebuffer};
+use crate::framebuffer::{Framebuffer, wins_depth_test};
 use crate::gpu::{ComputeSamples, TriWords, atomics, gpu};
 use crate::ground::{FieldError, PixelRect, SampleSpan};
 use crate::pipeline::ComputeKind;
@@ -208,9 +208,10 @@ fn decide_unsure(
                 continue;
             };
             samples.coverage_writes[i] += 1;
+            // An empty sample holds the background id at +∞.
             let (held, held_w) = (samples.triangle_id[i], samples.depth[i]);
             let wins = if depth_test {
-                held == BACKGROUND || w < held_w || (w == held_w && id < held)
+                wins_depth_test(w, id, held_w, held)
             } else {
                 id < held
             };

@@ -24,6 +24,8 @@
 const REJECT: u32 = 0u;
 const PARTIAL: u32 = 1u;
 const ACCEPT: u32 = 2u;
+// A tile of a block accepted whole: accepted without a test of its own.
+const UNTESTED: u32 = 3u;
 const ACCEPTED_BIT: u32 = 0x80000000u;
 
 // Tiles per side of a block (64×64 pixels: the first level of the tests).
@@ -61,9 +63,9 @@ fn tiles_test(t: Tri, t0: vec2<u32>, t1: vec2<u32>) -> u32 {
 // Tile (tx, ty) against triangle k, in a block whose test said `block`:
 // tested unless the block was accepted whole; then pass 0 counts it in the
 // tile's list, pass 1 writes it there. Returns the tile's outcome, or
-// PARTIAL + ACCEPT (untested) for a tile of an accepted block.
+// UNTESTED for a tile of an accepted block.
 fn bin_tile(t: Tri, k: u32, tx: u32, ty: u32, block: u32) -> u32 {
-    var outcome = ACCEPT + PARTIAL;
+    var outcome = UNTESTED;
     if block != ACCEPT {
         outcome = tiles_test(t, vec2<u32>(tx, ty), vec2<u32>(tx, ty));
         if outcome == REJECT {
@@ -75,7 +77,7 @@ fn bin_tile(t: Tri, k: u32, tx: u32, ty: u32, block: u32) -> u32 {
         atomicAdd(&tile_counts[tile], 1u);
     } else {
         let slot = tile_offsets[tile] + atomicAdd(&tile_cursor[tile], 1u);
-        tile_list[slot] = k | select(0u, ACCEPTED_BIT, outcome >= ACCEPT);
+        tile_list[slot] = k | select(0u, ACCEPTED_BIT, outcome == ACCEPT || outcome == UNTESTED);
     }
     return outcome;
 }
@@ -133,7 +135,7 @@ struct Tests {
 
 // Counts an outcome of a test (not the untested tiles of an accepted block).
 fn count(tests: ptr<function, Tests>, outcome: u32) {
-    if outcome <= ACCEPT {
+    if outcome != UNTESTED {
         (*tests).tested += 1u;
         (*tests).accepted += u32(outcome == ACCEPT);
         (*tests).rejected += u32(outcome == REJECT);
