@@ -21,21 +21,10 @@ use crate::simd::{Lanes, Portable};
 /// Relative padding of every box, beyond CWBVH quantisation and rounding.
 pub const BOX_PAD: f32 = 1.0 / (1 << 18) as f32;
 
-/// The eight child boxes of a CWBVH node, decoded to f32 and padded, laid out
-/// for 8-lane slab tests (empty children hold zeros and are masked out).
-#[derive(Clone, Copy, Debug, Default)]
-#[repr(C, align(32))]
-pub struct ChildBoxes {
-    pub lo: [[f32; 8]; 3],
-    pub hi: [[f32; 8]; 3],
-}
-
 /// A BVH over triangles. Its primitives are indices into `drawable`.
 #[derive(Clone, Debug)]
 pub struct SceneBvh {
     pub cwbvh: CwBvh,
-    /// Per node, its children's boxes in world space, padded by [`BOX_PAD`].
-    pub child_boxes: Vec<ChildBoxes>,
 }
 
 /// Index of `node` in `bvh.nodes` (the traversal hands out references).
@@ -46,23 +35,62 @@ fn node_index(bvh: &CwBvh, node: &CwBvhNode) -> usize {
         / std::mem::size_of::<CwBvhNode>()
 }
 
-/// Decodes a node's quantised child boxes to world space, padded.
-fn decode_children(node: &CwBvhNode) -> ChildBoxes {
-    let mut boxes = ChildBoxes::default();
-    let extent = node.compute_extent();
-    let p = Vec3A::from(node.p);
-    for child in 0..8 {
-        if node.is_child_empty(child) {
-            continue;
-        }
-        let local = node.local_child_aabb(child);
-        let (lo, hi) = padded(local.min * extent + p, local.max * extent + p);
+/// The eight child boxes of a CWBVH node, decoded from its quantised bytes in
+/// registers and padded, one child per lane: `lo[axis]`, `hi[axis]` (empty
+/// children hold whatever their bytes decode to; callers mask them out).
+///
+/// The node keeps its 80 bytes (obvhs's layout, paper-independent: an origin
+/// `p`, a power-of-two scale `2^e` per axis and six bytes per child); a child
+/// box is `q·2^e + p` per bound — the product is exact, so this is the one
+/// rounding obvhs's `child_aabb` makes — padded as [`padded`] pads, bit for
+/// bit, so the lane tests cull exactly what a child-by-child test culls.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Children<L> {
+    pub lo: [L; 3],
+    pub hi: [L; 3],
+}
+
+/// Eight quantised bounds as lanes.
+#[inline(always)]
+fn byte_lanes<L: Lanes>(bytes: &[u8; 8]) -> L {
+    L::from_array(bytes.map(f32::from))
+}
+
+/// `|x|` per lane (`maxps(x, −x)`; boxes hold no NaN).
+#[inline(always)]
+fn abs<L: Lanes>(x: L) -> L {
+    x.max(L::splat(0.0) - x)
+}
+
+impl<L: Lanes> Children<L> {
+    /// Decodes `node`'s children (see [`Children`]).
+    #[inline(always)]
+    pub(crate) fn decode(node: &CwBvhNode) -> Children<L> {
+        let scale = node.compute_extent();
+        let bytes = [
+            (&node.child_min_x, &node.child_max_x),
+            (&node.child_min_y, &node.child_max_y),
+            (&node.child_min_z, &node.child_max_z),
+        ];
+        let mut lo = [L::splat(0.0); 3];
+        let mut hi = [L::splat(0.0); 3];
         for a in 0..3 {
-            boxes.lo[a][child] = lo[a];
-            boxes.hi[a][child] = hi[a];
+            let (e, p) = (L::splat(scale[a]), L::splat(node.p[a]));
+            lo[a] = byte_lanes::<L>(bytes[a].0) * e + p;
+            hi[a] = byte_lanes::<L>(bytes[a].1) * e + p;
         }
+        // `padded`, per lane: the largest magnitude of either corner.
+        let mut largest = abs(lo[0]).max(abs(hi[0]));
+        for a in 1..3 {
+            largest = largest.max(abs(lo[a]).max(abs(hi[a])));
+        }
+        let pad = largest * L::splat(BOX_PAD) + L::splat(f32::MIN_POSITIVE);
+        for a in 0..3 {
+            lo[a] = lo[a] - pad;
+            hi[a] = hi[a] + pad;
+        }
+        Children { lo, hi }
     }
-    boxes
 }
 
 /// The padded box of each drawable triangle: the BVH's primitives.
@@ -102,15 +130,13 @@ impl SceneBvh {
         // The builder reserves for the worst case; keep what the tree holds.
         cwbvh.nodes.shrink_to_fit();
         cwbvh.primitive_indices.shrink_to_fit();
-        let child_boxes = cwbvh.nodes.iter().map(decode_children).collect();
-        SceneBvh { cwbvh, child_boxes }
+        SceneBvh { cwbvh }
     }
 
-    /// Heap bytes held: the nodes, the primitive order and the decoded child boxes.
+    /// Heap bytes held: the nodes and the primitive order.
     pub fn bytes(&self) -> usize {
         self.cwbvh.nodes.capacity() * std::mem::size_of::<CwBvhNode>()
             + self.cwbvh.primitive_indices.capacity() * 4
-            + self.child_boxes.capacity() * std::mem::size_of::<ChildBoxes>()
     }
 
     /// Checks obvhs's structural invariants against the primitive boxes; panics on
@@ -151,7 +177,7 @@ impl SceneBvh {
             state,
             {
                 visited += 1;
-                let hits = ray.hits8::<Portable>(&self.child_boxes[node_index(bvh, node)], tmax);
+                let hits = ray.hits8::<Portable>(&Children::decode(node), tmax);
                 child_mask(node, hits, state.oct_inv4)
             },
             {
@@ -229,11 +255,10 @@ impl SceneBvh {
             state,
             {
                 visited += 1;
-                let index = node_index(bvh, node);
                 if let Some(entered) = entered.as_deref_mut() {
-                    entered.push(index as u32);
+                    entered.push(node_index(bvh, node) as u32);
                 }
-                let boxes = &self.child_boxes[index];
+                let boxes = &Children::<L>::decode(node);
                 let hits = match &interval {
                     Some(interval) => interval.hits::<L>(boxes, tmax),
                     // A loop, not a closure: lane code must be inlined (see `crate::simd`).
@@ -264,12 +289,14 @@ impl SceneBvh {
 impl SceneBvh {
     /// Node `index`'s box: the union of its children's (padded) boxes.
     pub fn node_box(&self, index: usize) -> [[f32; 3]; 2] {
-        let (node, boxes) = (&self.cwbvh.nodes[index], &self.child_boxes[index]);
+        let node = &self.cwbvh.nodes[index];
+        let boxes = Children::<Portable>::decode(node);
         let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-        for child in (0..8).filter(|&c| !node.is_child_empty(c)) {
-            for a in 0..3 {
-                lo[a] = lo[a].min(boxes.lo[a][child]);
-                hi[a] = hi[a].max(boxes.hi[a][child]);
+        for a in 0..3 {
+            let (los, his) = (boxes.lo[a].to_array(), boxes.hi[a].to_array());
+            for child in (0..8).filter(|&c| !node.is_child_empty(c)) {
+                lo[a] = lo[a].min(los[child]);
+                hi[a] = hi[a].max(his[child]);
             }
         }
         [lo, hi]
@@ -397,7 +424,7 @@ impl PacketInterval {
     /// The children (bit per slot) some ray of the packet may meet before
     /// `tmax` (the largest culling distance of the packet).
     #[inline(always)]
-    fn hits<L: Lanes>(&self, boxes: &ChildBoxes, tmax: f32) -> u32 {
+    fn hits<L: Lanes>(&self, boxes: &Children<L>, tmax: f32) -> u32 {
         // An array, not a `map` closure: lane code must be inlined (`crate::simd`).
         let axes = [
             self.axis::<L>(boxes, 0),
@@ -411,10 +438,10 @@ impl PacketInterval {
     /// `min(ta, tb)` and an upper bound of its exit `max(ta, tb)`. (A function,
     /// not a closure: only `#[inline(always)]` code is compiled for the caller's lanes.)
     #[inline(always)]
-    fn axis<L: Lanes>(&self, boxes: &ChildBoxes, a: usize) -> (L, L) {
+    fn axis<L: Lanes>(&self, boxes: &Children<L>, a: usize) -> (L, L) {
         let (lo, hi) = (L::splat(self.inv_min[a]), L::splat(self.inv_max[a]));
-        let below = L::from_array(boxes.lo[a]) - L::splat(self.origin_lo[a]);
-        let above = L::from_array(boxes.hi[a]) - L::splat(self.origin_hi[a]);
+        let below = boxes.lo[a] - L::splat(self.origin_lo[a]);
+        let above = boxes.hi[a] - L::splat(self.origin_hi[a]);
         let (ta_lo, ta_hi) = (below * lo, below * hi);
         let (tb_lo, tb_hi) = (above * lo, above * hi);
         let near = ta_lo.min(ta_hi).min(tb_lo.min(tb_hi));
@@ -508,7 +535,7 @@ impl SlabRay {
     /// The children (bit per slot of `boxes`) this ray meets before `tmax`:
     /// eight slab tests side by side.
     #[inline(always)]
-    fn hits8<L: Lanes>(&self, boxes: &ChildBoxes, tmax: f32) -> u32 {
+    fn hits8<L: Lanes>(&self, boxes: &Children<L>, tmax: f32) -> u32 {
         // An array, not a `map` closure: lane code must be inlined (`crate::simd`).
         let axes = [
             self.axis::<L>(boxes, 0),
@@ -520,10 +547,10 @@ impl SlabRay {
 
     /// Along axis `a`, per child: the slab entry and exit distances.
     #[inline(always)]
-    fn axis<L: Lanes>(&self, boxes: &ChildBoxes, a: usize) -> (L, L) {
+    fn axis<L: Lanes>(&self, boxes: &Children<L>, a: usize) -> (L, L) {
         let inv = L::splat(self.inv[a]);
-        let ta = (L::from_array(boxes.lo[a]) - L::splat(self.origin_lo[a])) * inv;
-        let tb = (L::from_array(boxes.hi[a]) - L::splat(self.origin_hi[a])) * inv;
+        let ta = (boxes.lo[a] - L::splat(self.origin_lo[a])) * inv;
+        let tb = (boxes.hi[a] - L::splat(self.origin_hi[a])) * inv;
         (ta.min(tb), ta.max(tb))
     }
 }
@@ -550,13 +577,17 @@ mod tests {
                 .map(|l| (l % 5 != 4).then(|| SlabRay::new(origin, dir())))
                 .collect();
             let tmax: Vec<f32> = (0..PACKET).map(|_| f(0.0, 20.0)).collect();
-            let mut boxes = ChildBoxes::default();
+            let (mut lo, mut hi) = ([[0.0; 8]; 3], [[0.0; 8]; 3]);
             for c in 0..8 {
                 for a in 0..3 {
                     let (p, q) = (f(-10.0, 10.0), f(-10.0, 10.0));
-                    (boxes.lo[a][c], boxes.hi[a][c]) = (p.min(q), p.max(q));
+                    (lo[a][c], hi[a][c]) = (p.min(q), p.max(q));
                 }
             }
+            let boxes = Children {
+                lo: lo.map(lanes::<Portable>),
+                hi: hi.map(lanes::<Portable>),
+            };
             let interval = PacketInterval::of(&slabs).expect("one origin");
             let packet = interval.hits::<Portable>(&boxes, tmax.iter().fold(0.0, |m, &t| m.max(t)));
             let rays = slabs
@@ -574,6 +605,65 @@ mod tests {
             kept_extra < 4000 * 8 - met,
             "the interval test kept every box"
         );
+    }
+
+    /// A node's children decoded in lanes are obvhs's `child_aabb`s padded by
+    /// [`padded`], bit for bit, on both lane types: every node of a BVH over
+    /// random triangles far from the origin and near it.
+    #[test]
+    fn children_decode_in_lanes_as_child_by_child() {
+        let mut rng = fastrand::Rng::with_seed(13);
+        let mut checked = 0;
+        for (offset, size) in [(0.0, 1.0), (1e4, 3.0), (-37.5, 1e-3)] {
+            let triangles: Vec<[Vec3; 3]> = (0..3000)
+                .map(|_| {
+                    let c = Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 100.0 * size;
+                    let mut corner = || c + Vec3::new(rng.f32(), rng.f32(), rng.f32()) * size;
+                    [corner(), corner(), corner()].map(|p| p + Vec3::splat(offset))
+                })
+                .collect();
+            let drawable: Vec<u32> = (0..triangles.len() as u32).collect();
+            let bvh = SceneBvh::build(&triangles, &drawable);
+            for node in &bvh.cwbvh.nodes {
+                let decoded = Children::<Portable>::decode(node);
+                #[cfg(target_arch = "x86_64")]
+                let avx2 = crate::simd::cpu_has_avx2().then(|| {
+                    // SAFETY: this CPU has AVX2.
+                    let c = unsafe { decode_avx2(node) };
+                    (c.lo.map(array), c.hi.map(array))
+                });
+                for child in (0..8).filter(|&c| !node.is_child_empty(c)) {
+                    let aabb = node.child_aabb(child);
+                    let (lo, hi) = padded(aabb.min, aabb.max);
+                    for a in 0..3 {
+                        assert_eq!(array(decoded.lo[a])[child].to_bits(), lo[a].to_bits());
+                        assert_eq!(array(decoded.hi[a])[child].to_bits(), hi[a].to_bits());
+                        #[cfg(target_arch = "x86_64")]
+                        if let Some((alo, ahi)) = avx2 {
+                            assert_eq!(alo[a][child].to_bits(), lo[a].to_bits());
+                            assert_eq!(ahi[a][child].to_bits(), hi[a].to_bits());
+                        }
+                    }
+                    checked += 1;
+                }
+            }
+        }
+        // Every triangle's leaf and every inner node is some node's child.
+        assert!(checked > 3 * 3000 / 4, "only {checked} children checked");
+    }
+
+    fn lanes<L: Lanes>(values: [f32; 8]) -> L {
+        L::from_array(values)
+    }
+
+    fn array<L: Lanes>(lanes: L) -> [f32; 8] {
+        lanes.to_array()
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn decode_avx2(node: &CwBvhNode) -> Children<crate::simd::Avx2> {
+        Children::decode(node)
     }
 
     /// The interval built from directions eight lanes at a time is the one

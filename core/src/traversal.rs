@@ -13,9 +13,10 @@
 //! same image as `3dr-brute`.
 
 use glam::{Vec3, Vec3A};
+use obvhs::cwbvh::node::CwBvhNode;
 
 use crate::binning::raster_triangle;
-use crate::bvh::{SlabRay, padded};
+use crate::bvh::{Children, SlabRay, padded};
 use crate::camera::View;
 use crate::edge::Coverage;
 use crate::framebuffer::TileBuffer;
@@ -23,6 +24,7 @@ use crate::ground::PixelRect;
 use crate::pipeline::TraversalOracles;
 use crate::prepared::PreparedScene;
 use crate::screen_boxes::ScreenBoxes;
+use crate::simd::{Lanes, Portable};
 use crate::stats::RasterCounters;
 use crate::trace::{FrustumEvent, NodeOutcome};
 
@@ -102,6 +104,67 @@ struct NodeBox {
     lo: Vec3A,
     hi: Vec3A,
     min_w: f32,
+}
+
+impl NodeBox {
+    const EMPTY: NodeBox = NodeBox {
+        lo: Vec3A::ZERO,
+        hi: Vec3A::ZERO,
+        min_w: 0.0,
+    };
+}
+
+/// `n·(corner − eye)` for each box of `boxes`, `corner` its corner furthest
+/// along `n` (`furthest`) or against it, in [`dot`]'s order.
+#[inline(always)]
+fn along<L: Lanes>(boxes: &Children<L>, eye: Vec3A, n: Vec3A, furthest: bool) -> L {
+    let mut d = [L::splat(0.0); 3];
+    for a in 0..3 {
+        let corner = if (n[a] >= 0.0) == furthest {
+            boxes.hi[a]
+        } else {
+            boxes.lo[a]
+        };
+        d[a] = (corner - L::splat(eye[a])) * L::splat(n[a]);
+    }
+    (d[0] + d[1]) + d[2]
+}
+
+/// `(d.x·n.x + d.y·n.y) + d.z·n.z`: glam's order, written out so that the
+/// lane tests ([`ChildTests`]) round as the single-box ones.
+#[inline(always)]
+fn dot(d: Vec3A, n: Vec3A) -> f32 {
+    (d.x * n.x + d.y * n.y) + d.z * n.z
+}
+
+/// A CWBVH node's eight children against a frustum, one child per lane: their
+/// boxes decoded in registers ([`Children`]), each box's nearest view-axis
+/// distance, and which boxes lie wholly outside a side plane or nearer than
+/// `near` — the same tests, rounded the same way, as [`NodeBox`] and
+/// `Traversal::is_outside` make for one box.
+struct ChildTests<L> {
+    boxes: Children<L>,
+    min_w: L,
+    /// Bit per child slot (empty slots included: the caller skips them).
+    outside: u8,
+}
+
+impl<L: Lanes> ChildTests<L> {
+    #[inline(always)]
+    fn of(node: &CwBvhNode, frustum: &Frustum, v: &View) -> ChildTests<L> {
+        let boxes = Children::<L>::decode(node);
+        let eye = Vec3A::from(v.eye);
+        let fw = Vec3A::from(v.forward);
+        let mut outside = along(&boxes, eye, fw, true).lt(L::splat(v.near));
+        for &(n, offset) in &frustum.planes {
+            outside |= along(&boxes, eye, n, true).lt(L::splat(offset));
+        }
+        ChildTests {
+            min_w: along(&boxes, eye, fw, false),
+            boxes,
+            outside,
+        }
+    }
 }
 
 /// A frustum: its pixels, the four side planes through their borders, and
@@ -202,17 +265,24 @@ impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
         NodeBox {
             lo,
             hi,
-            min_w: (corner - Vec3A::from(self.view.eye)).dot(f),
+            min_w: dot(corner - Vec3A::from(self.view.eye), f),
         }
     }
 
-    /// Fig. 7.
+    /// Fig. 7: `node` met by `frustum`, tested against it first.
     fn traverse(&mut self, frustum: &Frustum, node: NodeRef, b: NodeBox) {
+        let outside = self.oracles.outside && self.is_outside(frustum, &b);
+        self.visit(frustum, node, b, outside);
+    }
+
+    /// Fig. 7 for a node whose `is_outside` answer is known (`outside`, false
+    /// when that oracle is off).
+    fn visit(&mut self, frustum: &Frustum, node: NodeRef, b: NodeBox, outside: bool) {
         self.nodes_visited += 1;
         let f = frustum.rect;
         // 1. is_outside / is_occluded (Fig. 6a).
         let node_box = |outcome| ([b.lo.to_array(), b.hi.to_array()], outcome);
-        if self.oracles.outside && self.is_outside(frustum, &b) {
+        if outside {
             self.counters.nodes_culled_outside += 1;
             self.tile
                 .record(|t| t.nodes.push(node_box(NodeOutcome::Outside)));
@@ -254,30 +324,49 @@ impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
             // 3. generate_samples at leaves (Fig. 6d).
             NodeRef::Leaf { start, count } => self.rasterize_leaf(f, start, count),
             // 4. Children, nearest first.
-            NodeRef::Inner(index) => {
-                let n = &self.scene.bvh.cwbvh.nodes[index as usize];
-                let mut children: [(f32, NodeRef, NodeBox); 8] = [(0.0, node, b); 8];
-                let mut len = 0;
-                for c in 0..8 {
-                    if n.is_child_empty(c) {
-                        continue;
-                    }
-                    let aabb = n.child_aabb(c);
-                    let cb = self.node_box(aabb.min, aabb.max);
-                    let r = if n.is_leaf(c) {
-                        let (start, count) = n.child_primitives(c);
-                        NodeRef::Leaf { start, count }
-                    } else {
-                        NodeRef::Inner(n.child_node_index(c))
-                    };
-                    children[len] = (cb.min_w, r, cb);
-                    len += 1;
-                }
-                children[..len].sort_by(|a, b| a.0.total_cmp(&b.0));
-                for &(_, r, cb) in &children[..len] {
-                    self.traverse(frustum, r, cb);
-                }
+            NodeRef::Inner(index) => self.visit_children(frustum, index),
+        }
+    }
+
+    /// The children of inner node `index`, nearest first: decoded and tested
+    /// against the frustum's planes eight at a time ([`ChildTests`]), then
+    /// visited one by one.
+    fn visit_children(&mut self, frustum: &Frustum, index: u32) {
+        let n = &self.scene.bvh.cwbvh.nodes[index as usize];
+        let tests = ChildTests::<Portable>::of(n, frustum, self.view);
+        let outside = if self.oracles.outside {
+            tests.outside
+        } else {
+            0
+        };
+        let (lo, hi) = (
+            tests.boxes.lo.map(|l| l.to_array()),
+            tests.boxes.hi.map(|l| l.to_array()),
+        );
+        let min_w = tests.min_w.to_array();
+        let mut children = [(0.0, NodeRef::Inner(index), NodeBox::EMPTY, false); 8];
+        let mut len = 0;
+        for c in 0..8 {
+            if n.is_child_empty(c) {
+                continue;
             }
+            let r = if n.is_leaf(c) {
+                let (start, count) = n.child_primitives(c);
+                NodeRef::Leaf { start, count }
+            } else {
+                NodeRef::Inner(n.child_node_index(c))
+            };
+            let b = NodeBox {
+                lo: Vec3A::new(lo[0][c], lo[1][c], lo[2][c]),
+                hi: Vec3A::new(hi[0][c], hi[1][c], hi[2][c]),
+                min_w: min_w[c],
+            };
+            children[len] = (b.min_w, r, b, outside >> c & 1 == 1);
+            len += 1;
+        }
+        children[..len].sort_by(|a, b| a.0.total_cmp(&b.0));
+        for &(_, r, b, outside) in &children[..len] {
+            self.visit(frustum, r, b, outside);
         }
     }
 
@@ -289,14 +378,14 @@ impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
         for &(n, offset) in &f.planes {
             // The corner furthest along n.
             let corner = Vec3A::select(n.cmpge(Vec3A::ZERO), b.hi, b.lo);
-            if (corner - eye).dot(n) < offset {
+            if dot(corner - eye, n) < offset {
                 return true;
             }
         }
         // Wholly nearer than near: the farthest corner along the view axis.
         let fw = Vec3A::from(v.forward);
         let far = Vec3A::select(fw.cmpge(Vec3A::ZERO), b.hi, b.lo);
-        (far - eye).dot(fw) < v.near
+        dot(far - eye, fw) < v.near
     }
 
     /// Is the box behind what the hierarchical w-buffer holds: over the whole
