@@ -557,6 +557,101 @@ fn compare_measures_each_thread_count() {
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--threads"));
 }
 
+/// `--oracles` adds, for each setting, a row beside every algorithm it
+/// changes (and none beside those it does not), renders the same image, and
+/// the table ends with the fastest setting of each algorithm.
+#[test]
+fn compare_measures_oracle_settings_beside_the_algorithms_own() {
+    let dir = out_dir("compare-oracles");
+    let out = continuum(&[
+        "compare",
+        "--scenes",
+        "teapots",
+        "--algorithms",
+        "2dr-brute,3dr-bin,3dr-full",
+        "--oracles",
+        "frustum=64,split=16;early_z=off",
+        "--size",
+        "96x64",
+        "--repeat",
+        "1",
+        "--threads",
+        "2",
+        "--out",
+        dir.to_str().expect("utf-8"),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let doc = results_json(&dir);
+    let rows = doc["rows"].as_array().expect("rows");
+    let names: Vec<&str> = rows
+        .iter()
+        .map(|r| r["algorithm"].as_str().expect("algorithm"))
+        .collect();
+    // 2dr-brute takes no traversal keys and has early-z off already: no rows.
+    assert_eq!(
+        names,
+        [
+            "2dr-brute",
+            "3dr-bin",
+            "3dr-full",
+            "3dr-full[split=16,frustum=64]",
+            "3dr-bin[early_z=off]",
+            "3dr-full[early_z=off]",
+        ]
+    );
+    let hash = |r: &serde_json::Value| r["hashes"]["triangle_id"].clone();
+    for row in rows {
+        assert_eq!(hash(row), hash(&rows[0]), "{row}");
+        assert_eq!(row["agrees"], true, "{row}");
+        let tuned = row["algorithm"].as_str().expect("algorithm").contains('[');
+        assert_eq!(row.get("oracles").is_some(), tuned, "{row}");
+    }
+    // The settings change what the traversal does.
+    let stat = |i: usize, k: &str| rows[i]["stats"][k].as_u64().expect(k);
+    assert_ne!(stat(2, "frusta_split"), stat(3, "frusta_split"));
+    assert!(stat(4, "early_z_rejects") == 0 && stat(1, "early_z_rejects") > 0);
+    let best: Vec<&str> = stdout
+        .lines()
+        .skip_while(|l| !l.starts_with("fastest oracles"))
+        .skip(1)
+        .take_while(|l| !l.is_empty())
+        .collect();
+    assert_eq!(best.len(), 2, "{stdout}");
+    assert!(best[0].contains(": 3dr-bin -> 3dr-bin") && best[1].contains(": 3dr-full -> 3dr-full"));
+    let csv = std::fs::read_to_string(dir.join("results.csv")).expect("results.csv");
+    assert_eq!(csv.lines().count(), 7, "{csv}");
+    assert!(
+        csv.contains("\nteapots,\"3dr-full[split=16,frustum=64]\","),
+        "{csv}"
+    );
+
+    for (oracles, algorithms, says) in [
+        ("split=16", "2dr-brute", "changes none"),
+        ("bogus=1", "3dr-full", "unknown oracle"),
+    ] {
+        let bad = continuum(&[
+            "compare",
+            "--algorithms",
+            algorithms,
+            "--oracles",
+            oracles,
+            "--out",
+            "/tmp/never",
+        ]);
+        assert_eq!(bad.status.code(), Some(2));
+        let stderr = String::from_utf8_lossy(&bad.stderr);
+        assert!(
+            stderr.contains("--oracles") && stderr.contains(says),
+            "{stderr}"
+        );
+    }
+}
+
 #[test]
 fn compare_refuses_unknown_algorithms() {
     let out = continuum(&["compare", "--algorithms", "zbuffer", "--out", "/tmp/never"]);

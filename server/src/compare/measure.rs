@@ -12,8 +12,8 @@ use super::peer::run_peer;
 use anyhow::Context;
 use continuum::metrics::{self, ImageError};
 use continuum::{
-    AaMode, AlgorithmId, Camera, Family, Framebuffer, Precision, PreparedScene, RenderRequest,
-    StageTimes, View, maps, render,
+    AaMode, AlgorithmId, Camera, Family, Framebuffer, Oracles, Precision, PreparedScene,
+    RenderRequest, StageTimes, View, maps, render,
 };
 use serde_json::{Value, json};
 
@@ -91,16 +91,14 @@ pub fn measure_cell(
         .entries
         .iter()
         .copied()
-        .filter(|&entry| match entry {
-            Entry::Algorithm(a) => continuum::check(
+        .filter(|&entry| match entry.algorithm() {
+            Some(a) => continuum::check(
                 &algorithm_request(a, &camera, cell, sweep),
                 Some(&scene.prepared),
             )
             .is_ok(),
             // Peers cast one ray per pixel in their own precision.
-            Entry::Peer(_) => {
-                cell.aa == AaMode::None && cell.precision == Precision::F32 && cell.depth_test
-            }
+            None => cell.aa == AaMode::None && cell.precision == Precision::F32 && cell.depth_test,
         })
         .collect();
     // 2. continuum's CPU algorithms, timed interleaved: one warm-up render
@@ -109,12 +107,10 @@ pub fn measure_cell(
     //    ratios between them stay fair. (The GPU algorithms are timed each in
     //    a block of its own like the peers: lavapipe's threads outlive its
     //    frames and would slow whichever render came next.)
-    let algorithms: Vec<AlgorithmId> = serving
+    let algorithms: Vec<(AlgorithmId, Oracles)> = serving
         .iter()
-        .filter_map(|e| match e {
-            Entry::Algorithm(a) if a.family() != Family::Gpu => Some(*a),
-            _ => None,
-        })
+        .filter_map(|e| e.algorithm())
+        .filter(|(a, _)| a.family() != Family::Gpu)
         .collect();
     progress.set_message(format!(
         "{name} {} {} {}: {} algorithms over {} rounds",
@@ -142,15 +138,20 @@ pub fn measure_cell(
         ));
         let mut m = match entry {
             Entry::Algorithm(a) if a.family() == Family::Gpu => {
-                let request = algorithm_request(a, &camera, cell, sweep);
+                let request = algorithm_request((a, Oracles::default()), &camera, cell, sweep);
                 let (out, times) = time_interleaved(pool, scene, &[request], sweep.repeat)?
                     .pop()
                     .with_context(|| format!("one timed render for {a}"))?;
                 algorithm_row(scene, (a, cell), sweep, threads, out, times)
             }
-            Entry::Algorithm(a) => {
+            Entry::Algorithm(a) | Entry::Tuned(a, _) => {
                 let (out, times) = timed.next().context("one timed render per algorithm")?;
-                algorithm_row(scene, (a, cell), sweep, threads, out, times)
+                let mut m = algorithm_row(scene, (a, cell), sweep, threads, out, times);
+                if let Entry::Tuned(_, oracles) = entry {
+                    m.row.algorithm = entry.name();
+                    m.row.oracles = Some(oracles.to_string());
+                }
+                m
             }
             Entry::Peer(p) => {
                 let view = View::new(&camera, width, height, scene.prepared.default_near)
@@ -200,12 +201,13 @@ struct Measured {
 
 /// The request that renders `algorithm` in `cell`.
 fn algorithm_request(
-    algorithm: AlgorithmId,
+    (algorithm, oracles): (AlgorithmId, Oracles),
     camera: &Camera,
     cell: &Cell,
     sweep: &Sweep,
 ) -> RenderRequest {
     RenderRequest {
+        oracles,
         aa: cell.aa,
         precision: cell.precision,
         depth_test: cell.depth_test,
@@ -320,9 +322,11 @@ fn relate_in_cell(rows: &mut [Measured]) {
     let reference = three_d.or(position(AlgorithmId::Gpu3dr));
     let mut family_reference: HashMap<String, usize> = HashMap::new();
     for i in 0..rows.len() {
+        // An `--oracles` row (`ID[SETTING]`) belongs to its algorithm's family.
+        let id = rows[i].row.algorithm.split('[').next();
         let cpu = AlgorithmId::CPU
             .into_iter()
-            .find(|a| a.as_str() == rows[i].row.algorithm);
+            .find(|a| Some(a.as_str()) == id);
         match cpu {
             Some(a) => {
                 let family = format!("{:?}", a.family());

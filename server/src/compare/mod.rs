@@ -34,7 +34,7 @@ pub struct CompareArgs {
     command: Option<CompareCommand>,
     /// A sweep file describing the matrix (scenes, algorithms, viewports, aa,
     /// precision, size, repeat, threads, camera); instead of those flags.
-    #[arg(long, conflicts_with_all = ["scenes", "algorithms", "camera", "viewports", "aa", "precision", "size", "repeat", "threads"])]
+    #[arg(long, conflicts_with_all = ["scenes", "algorithms", "camera", "viewports", "aa", "precision", "size", "repeat", "threads", "oracles"])]
     sweep: Option<PathBuf>,
     /// Run only part I of N (0-based: 0/4 … 3/4) of the sweep's cells.
     #[arg(long, value_parser = Shard::parse)]
@@ -72,6 +72,12 @@ pub struct CompareArgs {
     /// report their time against f32 [default: f32].
     #[arg(long, value_delimiter = ',')]
     precision: Vec<String>,
+    /// Oracle settings, semicolon-separated, each in `render --oracles` words
+    /// (e.g. `frustum=128,split=16;split=off`): every algorithm a setting
+    /// changes gets a row `ALGORITHM[SETTING]` beside its own, and the table
+    /// ends with the fastest setting per scene, cell and algorithm.
+    #[arg(long, value_delimiter = ';')]
+    oracles: Vec<String>,
     /// Folder for results.json, results.csv and report.html (required).
     #[arg(long, required = true)]
     out: Option<PathBuf>,
@@ -158,6 +164,10 @@ pub struct Row {
     /// The edge-evaluation thumbnail, relative to the output folder.
     #[serde(default)]
     pub map: Option<String>,
+    /// The oracle settings on top of the algorithm's own (`--oracles` rows,
+    /// whose `algorithm` reads `ID[SETTING]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub oracles: Option<String>,
 }
 
 impl Row {
@@ -204,6 +214,7 @@ impl Row {
             flip_mean: None,
             cell: 0,
             map: None,
+            oracles: None,
         }
     }
 
@@ -336,6 +347,7 @@ fn sweep_from_flags(args: &CompareArgs) -> SweepFile {
         },
         camera: args.camera.clone(),
         depth_test: None,
+        oracles: list(&args.oracles),
     }
 }
 
@@ -557,6 +569,16 @@ fn machine(threads: &[usize]) -> Value {
     })
 }
 
+/// A CSV field as RFC 4180 writes it: quoted when it holds a comma, a quote
+/// or a line break (an `--oracles` row's label, a scene path).
+fn csv_field(text: &str) -> std::borrow::Cow<'_, str> {
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\"")).into()
+    } else {
+        text.into()
+    }
+}
+
 fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
     let mut f =
         std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
@@ -573,9 +595,9 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
         };
         text.push_str(&format!(
             "{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{:.0},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
-            r.scene,
-            r.algorithm,
-            r.camera,
+            csv_field(&r.scene),
+            csv_field(&r.algorithm),
+            csv_field(&r.camera),
             r.viewport,
             r.aa,
             r.precision,
@@ -634,9 +656,11 @@ fn depth_test_on() -> bool {
 fn table_text(rows: &[Row]) -> String {
     use std::fmt::Write;
     let mut out = String::new();
+    // `--oracles` rows' labels are longer than the ids.
+    let width = rows.iter().map(|r| r.algorithm.len()).fold(18, usize::max);
     writeln!(
         out,
-        "{:<16} {:<18} {:<16} {:<10} {:<5} {:>3} {:>10} {:>8} {:>9} {:>7} {:>7} {:>6} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
+        "{:<16} {:<width$} {:<16} {:<10} {:<5} {:>3} {:>10} {:>8} {:>9} {:>7} {:>7} {:>6} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
         "scene",
         "algorithm",
         "viewport",
@@ -666,7 +690,7 @@ fn table_text(rows: &[Row]) -> String {
         };
         writeln!(
             out,
-            "{:<16} {:<18} {:<16} {:<10} {:<5} {:>3} {:>10.2} {:>8} {:>9} {:>7} {:>7} {:>6} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
+            "{:<16} {:<width$} {:<16} {:<10} {:<5} {:>3} {:>10.2} {:>8} {:>9} {:>7} {:>7} {:>6} {:>7} {:>7} {:>9} {:>9} {:>7} {:>7}",
             r.scene,
             r.algorithm,
             r.viewport,
@@ -693,6 +717,26 @@ fn table_text(rows: &[Row]) -> String {
         )
         .ok();
     }
+    let best = fastest_oracles(rows);
+    if !best.is_empty() {
+        writeln!(out, "\nfastest oracles (scene, viewport, aa, precision, threads: algorithm -> fastest row, median ms, x own setting)").ok();
+        for b in best {
+            writeln!(
+                out,
+                "{} {} {} {} {}: {} -> {} {:.2} ms x{:.3}",
+                b.own.scene,
+                b.own.viewport,
+                b.own.aa,
+                b.own.precision,
+                b.own.threads,
+                b.own.algorithm,
+                b.fastest.algorithm,
+                b.fastest.median_ms,
+                b.fastest.median_ms / b.own.median_ms
+            )
+            .ok();
+        }
+    }
     if let Some(table) = report::sect5_rows(rows) {
         writeln!(out, "\n{}", report::SECT5_TITLE).ok();
         for line in table {
@@ -700,6 +744,38 @@ fn table_text(rows: &[Row]) -> String {
         }
     }
     out
+}
+
+/// An algorithm's row at its own oracle settings and the fastest of it and
+/// its `--oracles` rows in the same cell and thread count.
+pub struct FastestOracles<'r> {
+    pub own: &'r Row,
+    pub fastest: &'r Row,
+}
+
+/// For every row that has `--oracles` rows beside it: the fastest setting.
+pub fn fastest_oracles(rows: &[Row]) -> Vec<FastestOracles<'_>> {
+    let mut best = Vec::new();
+    for own in rows.iter().filter(|r| r.oracles.is_none()) {
+        let prefix = format!("{}[", own.algorithm);
+        let tuned = rows.iter().filter(|r| {
+            r.oracles.is_some()
+                && r.algorithm.starts_with(&prefix)
+                && (&r.scene, r.cell, r.threads) == (&own.scene, own.cell, own.threads)
+        });
+        let mut fastest = own;
+        let mut any = false;
+        for r in tuned {
+            any = true;
+            if r.median_ms < fastest.median_ms {
+                fastest = r;
+            }
+        }
+        if any {
+            best.push(FastestOracles { own, fastest });
+        }
+    }
+    best
 }
 
 /// The share of a render's time spent on the frame around its algorithm:

@@ -14,13 +14,20 @@
 //! repeat = 3
 //! threads = [1, 2]                                     # or one count; default: all cores
 //! camera = "front"                                     # default: each scene's first
+//! oracles = ["frustum=128,split=16", "split=off"]      # extra rows; default: none
 //! ```
+//!
+//! Each `oracles` setting (the words of `render --oracles`) adds a row for
+//! every algorithm of the sweep it changes, labelled `ALGORITHM[SETTING]`
+//! (e.g. `3dr-full[frustum=128,split=16]`), timed in the same rounds as the
+//! algorithms' own settings; the printed table ends with the fastest setting
+//! of each scene, cell and algorithm.
 //! Unknown keys and bad values are errors naming the key.
 
 use std::path::Path;
 
 use super::peer::PeerId;
-use continuum::{AaMode, AlgorithmId, Precision, Viewport};
+use continuum::{AaMode, AlgorithmId, Oracles, Precision, Viewport};
 use continuum::{parse_algorithm, parse_size};
 use serde::{Deserialize, Serialize};
 
@@ -43,6 +50,9 @@ pub struct SweepFile {
     /// GPU experiment, rendered by the GPU compute algorithms only.
     #[serde(default)]
     pub depth_test: Option<Vec<bool>>,
+    /// Oracle settings, each measured as extra rows of every algorithm it changes.
+    #[serde(default)]
+    pub oracles: Option<Vec<String>>,
 }
 
 /// The sweep file's `threads`: one count or a list of counts, each measured.
@@ -57,16 +67,59 @@ pub enum Threads {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Entry {
     Algorithm(AlgorithmId),
+    /// An algorithm with oracle settings on top of its own.
+    Tuned(AlgorithmId, Oracles),
     Peer(PeerId),
 }
 
 impl Entry {
-    pub fn name(self) -> &'static str {
+    /// The row's label: the id, or `ID[SETTING]` for a tuned algorithm.
+    pub fn name(self) -> String {
         match self {
-            Entry::Algorithm(a) => a.as_str(),
-            Entry::Peer(p) => p.as_str(),
+            Entry::Algorithm(a) => a.as_str().into(),
+            Entry::Tuned(a, o) => format!("{a}[{o}]"),
+            Entry::Peer(p) => p.as_str().into(),
         }
     }
+
+    /// A continuum algorithm and the oracle settings it runs with (none for a peer).
+    pub fn algorithm(self) -> Option<(AlgorithmId, Oracles)> {
+        match self {
+            Entry::Algorithm(a) => Some((a, Oracles::default())),
+            Entry::Tuned(a, o) => Some((a, o)),
+            Entry::Peer(_) => None,
+        }
+    }
+}
+
+/// The tuned entries: each setting of `settings` for every algorithm of
+/// `entries` whose pipeline it changes. A setting that is not valid oracle
+/// words, or that changes none of them, is an error naming `oracles`.
+fn tuned_entries(entries: &[Entry], settings: &[String]) -> Result<Vec<Entry>, CliError> {
+    let bad = |m: String| CliError::Usage(format!("oracles: {m}"));
+    if settings.is_empty() {
+        return Err(bad("an empty list".into()));
+    }
+    let mut tuned = Vec::new();
+    for text in settings {
+        let oracles = Oracles::parse(text).map_err(|e| bad(e.message))?;
+        let before = tuned.len();
+        for entry in entries {
+            let Entry::Algorithm(a) = *entry else {
+                continue;
+            };
+            let own = a.pipeline();
+            if own.with_oracles(&oracles).is_ok_and(|p| p != own) {
+                tuned.push(Entry::Tuned(a, oracles));
+            }
+        }
+        if tuned.len() == before {
+            return Err(bad(format!(
+                "'{text}' changes none of the sweep's algorithms (the traversal keys need 3dr-frustum-cull, 3dr-frustum-split or 3dr-full)"
+            )));
+        }
+    }
+    Ok(tuned)
 }
 
 /// A viewport as a sweep names it: the camera's own, or one in the CLI's words
@@ -138,7 +191,11 @@ impl Sweep {
         } else {
             file.scenes.clone()
         };
-        let (entries, not_run) = parse_entries(file.algorithms.as_deref().unwrap_or_default())?;
+        let (mut entries, not_run) = parse_entries(file.algorithms.as_deref().unwrap_or_default())?;
+        if let Some(settings) = &file.oracles {
+            let tuned = tuned_entries(&entries, settings)?;
+            entries.extend(tuned);
+        }
         let viewports = match &file.viewports {
             None => vec![ViewportChoice::Camera],
             Some(list) if list.is_empty() => return Err(bad("viewports", "is empty".into())),
