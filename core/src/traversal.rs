@@ -452,14 +452,15 @@ impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
             let Some(clip) = leaf.rect.and_then(|rect| rect.intersect(f)) else {
                 continue;
             };
-            let tri = match leaf.tri {
+            // By reference: a setup is larger than a cache line.
+            let tri = match &mut leaf.tri {
                 Some(tri) => {
                     self.counters.leaf_setups_reused += 1;
                     tri
                 }
-                None => {
+                none => {
                     self.setups += 1;
-                    *leaf.tri.insert((self.setup)(p, view))
+                    none.insert((self.setup)(p, view))
                 }
             };
             let Some(tri) = tri else {
@@ -468,7 +469,7 @@ impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
             let id = scene.slot_triangles[slot as usize];
             raster_triangle(
                 self.tile,
-                &tri,
+                tri,
                 id,
                 clip,
                 self.oracles.samples,
