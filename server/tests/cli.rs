@@ -580,12 +580,7 @@ fn compare_measures_oracle_settings_beside_the_algorithms_own() {
         "--out",
         dir.to_str().expect("utf-8"),
     ]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = succeeded(&out);
     let doc = results_json(&dir);
     let rows = doc["rows"].as_array().expect("rows");
     let names: Vec<&str> = rows
@@ -950,6 +945,16 @@ const WITHOUT_VULKAN: [(&str, &str); 2] = [
     ("VK_DRIVER_FILES", "/nonexistent/icd.json"),
 ];
 
+/// The standard output of a run that must succeed (its stderr otherwise).
+fn succeeded(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
 fn no_panic(out: &Output) -> String {
     let stderr = String::from_utf8_lossy(&out.stderr).to_string();
     assert!(!stderr.contains("panicked"), "a panic: {stderr}");
@@ -1238,12 +1243,7 @@ fn the_section_5_sweep_sets_the_gpu_kernels_side_by_side_in_agreement() {
         "--out",
         dir.to_str().expect("utf-8"),
     ]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = succeeded(&out);
     let results = results_json(&dir);
     let rows = results["rows"].as_array().expect("rows");
     let kernels = [
