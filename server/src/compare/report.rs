@@ -170,7 +170,8 @@ fn fig9(h: &mut String, rows: &[Row]) {
             .flatten()
             .fold(1.0f64, f64::max)
             .min(20.0);
-        let (label_w, plot_w, row_h) = (170.0, 520.0, 26.0);
+        let label_w = label_width(bars.iter().map(|r| r.algorithm.as_str()));
+        let (plot_w, row_h) = (520.0, 26.0);
         let height = bars.len() as f64 * row_h + 30.0;
         let x = |v: f64| label_w + plot_w * (v.min(max) / max);
         let _ = writeln!(
@@ -264,7 +265,8 @@ fn stages(h: &mut String, rows: &[Row]) {
             .iter()
             .map(|(_, t)| t.total)
             .fold(f64::MIN_POSITIVE, f64::max);
-        let (label_w, plot_w, row_h) = (170.0, 620.0, 18.0);
+        let label_w = label_width(bars.iter().map(|(r, _)| r.algorithm.as_str()));
+        let (plot_w, row_h) = (620.0, 18.0);
         let height = bars.len() as f64 * row_h + 12.0;
         let _ = writeln!(
             h,
@@ -585,4 +587,11 @@ fn all_rows(h: &mut String, rows: &[Row]) {
         );
     }
     h.push_str("</table>\n");
+}
+
+/// The width of an SVG chart's label column, in pixels: room for its longest
+/// label at 11 px sans-serif (`--oracles` rows' labels are long), 170 at least.
+fn label_width<'a>(labels: impl Iterator<Item = &'a str>) -> f64 {
+    let longest = labels.map(|l| l.chars().count()).max().unwrap_or(0);
+    (longest as f64 * 6.5 + 12.0).max(170.0)
 }
