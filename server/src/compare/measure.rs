@@ -170,6 +170,7 @@ pub fn measure_cell(
                 row.visibility_ms = Some(row.median_ms);
                 Measured {
                     row,
+                    algorithm: None,
                     keys: run.triangle_id.iter().map(|&t| u64::from(t)).collect(),
                     fb: None,
                 }
@@ -195,6 +196,8 @@ pub fn measure_cell(
 /// continuum's own algorithms, the framebuffer.
 struct Measured {
     row: Row,
+    /// The continuum algorithm rendered (`None`: a peer).
+    algorithm: Option<AlgorithmId>,
     keys: Vec<u64>,
     fb: Option<Framebuffer>,
 }
@@ -306,6 +309,7 @@ fn algorithm_row(
     };
     Measured {
         row,
+        algorithm: Some(algorithm),
         keys,
         fb: Some(fb),
     }
@@ -322,11 +326,8 @@ fn relate_in_cell(rows: &mut [Measured]) {
     let reference = three_d.or(position(AlgorithmId::Gpu3dr));
     let mut family_reference: HashMap<String, usize> = HashMap::new();
     for i in 0..rows.len() {
-        // An `--oracles` row (`ID[SETTING]`) belongs to its algorithm's family.
-        let id = rows[i].row.algorithm.split('[').next();
-        let cpu = AlgorithmId::CPU
-            .into_iter()
-            .find(|a| Some(a.as_str()) == id);
+        // `--oracles` rows too: each belongs to its algorithm's family.
+        let cpu = rows[i].algorithm.filter(|a| AlgorithmId::CPU.contains(a));
         match cpu {
             Some(a) => {
                 let family = format!("{:?}", a.family());

@@ -755,27 +755,23 @@ pub struct FastestOracles<'r> {
 
 /// For every row that has `--oracles` rows beside it: the fastest setting.
 pub fn fastest_oracles(rows: &[Row]) -> Vec<FastestOracles<'_>> {
-    let mut best = Vec::new();
-    for own in rows.iter().filter(|r| r.oracles.is_none()) {
-        let prefix = format!("{}[", own.algorithm);
-        let tuned = rows.iter().filter(|r| {
-            r.oracles.is_some()
-                && r.algorithm.starts_with(&prefix)
-                && (&r.scene, r.cell, r.threads) == (&own.scene, own.cell, own.threads)
-        });
-        let mut fastest = own;
-        let mut any = false;
-        for r in tuned {
-            any = true;
-            if r.median_ms < fastest.median_ms {
-                fastest = r;
-            }
-        }
-        if any {
-            best.push(FastestOracles { own, fastest });
-        }
-    }
-    best
+    let own_rows = rows.iter().filter(|r| r.oracles.is_none());
+    own_rows
+        .filter_map(|own| {
+            let prefix = format!("{}[", own.algorithm);
+            let mut tuned = rows
+                .iter()
+                .filter(|r| {
+                    r.oracles.is_some()
+                        && r.algorithm.starts_with(&prefix)
+                        && (&r.scene, r.cell, r.threads) == (&own.scene, own.cell, own.threads)
+                })
+                .peekable();
+            tuned.peek()?;
+            let fastest = tuned.fold(own, |f, r| if r.median_ms < f.median_ms { r } else { f });
+            Some(FastestOracles { own, fastest })
+        })
+        .collect()
 }
 
 /// The share of a render's time spent on the frame around its algorithm:
