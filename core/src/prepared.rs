@@ -184,6 +184,23 @@ impl PreparedScene {
             slot => self.slot_corners[slot as usize],
         }
     }
+
+    /// Triangle `id`'s vertex positions and vertex indices, read from the
+    /// slot-ordered copies where the BVH holds it: triangles side by side on
+    /// screen are side by side there, whatever the mesh's own order.
+    #[inline(always)]
+    pub(crate) fn corners_and_vertices(&self, id: u32) -> ([Vec3; 3], [u32; 3]) {
+        match self.slot_of[id as usize] {
+            NO_SLOT => (
+                self.scene.mesh.triangle_positions(id as usize),
+                self.scene.mesh.triangles[id as usize],
+            ),
+            slot => (
+                self.slot_corners[slot as usize],
+                self.slot_vertices[slot as usize],
+            ),
+        }
+    }
 }
 
 /// [`PreparedScene::slot_of`] of a triangle the BVH does not hold.

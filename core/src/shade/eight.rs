@@ -151,7 +151,6 @@ impl Shader<'_> {
         let first = s.ids[done.trailing_zeros() as usize];
         let mut corners = [[Vec3::ZERO; 8]; 3];
         let mut vertex_normals = [[Vec3::ZERO; 8]; 3];
-        let mut face = [Vec3::ZERO; 8];
         let mut base = [Vec3::ZERO; 8];
         let mut emissive = [Vec3::ZERO; 8];
         for l in 0..8 {
@@ -160,16 +159,15 @@ impl Shader<'_> {
             } else {
                 first
             } as usize;
-            let p = prepared.triangle(id as u32);
+            let (p, vertices) = prepared.corners_and_vertices(id as u32);
             for k in 0..3 {
                 corners[k][l] = p[k];
             }
-            face[l] = prepared.face_normals[id];
             let material = &prepared.scene.materials[mesh.material_ids[id] as usize];
             base[l] = Vec3::from_slice(&material.base_color[..3]);
             emissive[l] = Vec3::from(material.emissive);
             if interpolated {
-                for (k, &v) in mesh.triangles[id].iter().enumerate() {
+                for (k, &v) in vertices.iter().enumerate() {
                     vertex_normals[k][l] = mesh.normals[v as usize];
                 }
                 if (0..3).any(|k| vertex_normals[k][l] == Vec3::ZERO) {
@@ -196,8 +194,11 @@ impl Shader<'_> {
         done &= !denom.eq(L::splat(0.0)) & finite(t);
         let point = origin.add(dir.scale(t));
 
-        // 4. The shading normal, facing the ray (`shading_normal`).
-        let facing = V3::of(&face);
+        // 4. The shading normal, facing the ray (`shading_normal`): the face
+        // normal is the scene's `face_normals` entry, `normal` normalized (a
+        // lane where that fails goes scalar).
+        let (facing, ok) = normal.normalized();
+        done &= ok;
         let flip = facing.dot(dir).gt(L::splat(0.0));
         let toward = L::from_array(std::array::from_fn(|l| match flip & (1 << l) {
             0 => 1.0,
