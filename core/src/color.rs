@@ -27,17 +27,18 @@ const SRGB_BUCKETS: usize = 4096;
 /// [`encode_srgb_formula`] as tables: the first byte of each of
 /// [`SRGB_BUCKETS`] equal buckets, and per byte the smallest linear value
 /// that encodes to it (found by bisection over `f32` bit patterns, which
-/// order non-negative values).
+/// order non-negative values), with `+∞` after the last: no byte past 255.
 struct SrgbTable {
     bucket_start: Vec<u8>,
-    thresholds: [f32; 256],
+    thresholds: [f32; 257],
 }
 
 fn srgb_table() -> &'static SrgbTable {
     static TABLE: std::sync::OnceLock<SrgbTable> = std::sync::OnceLock::new();
     TABLE.get_or_init(|| {
-        let mut thresholds = [0.0f32; 256];
-        for (b, t) in thresholds.iter_mut().enumerate().skip(1) {
+        let mut thresholds = [f32::INFINITY; 257];
+        thresholds[0] = 0.0;
+        for (b, t) in thresholds.iter_mut().enumerate().take(256).skip(1) {
             let (mut lo, mut hi) = (0u32, 1.0f32.to_bits());
             while lo < hi {
                 let mid = lo + (hi - lo) / 2;
@@ -74,7 +75,10 @@ pub fn encode_srgb(v: f32) -> u8 {
     let table = srgb_table();
     // Exact: scaling by a power of two does not round.
     let mut b = table.bucket_start[(v * SRGB_BUCKETS as f32) as usize];
-    while b < 255 && v >= table.thresholds[usize::from(b) + 1] {
+    // A bucket is narrower than a byte's step almost everywhere: the first
+    // step without a branch, a second in the loop's rare turn.
+    b += u8::from(v >= table.thresholds[usize::from(b) + 1]);
+    while v >= table.thresholds[usize::from(b) + 1] {
         b += 1;
     }
     b
@@ -119,7 +123,7 @@ mod tests {
             f32::INFINITY,
             0.003_130_8,
         ];
-        for &t in &table.thresholds {
+        for &t in &table.thresholds[..256] {
             for d in -3i32..=3 {
                 values.push(f32::from_bits(t.to_bits().saturating_add_signed(d)));
             }

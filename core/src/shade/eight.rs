@@ -132,8 +132,7 @@ impl Shader<'_> {
     /// Whether triangle `id`'s samples can be shaded by [`Shader::shade_eight`].
     #[inline(always)]
     pub(crate) fn shades_in_lanes(&self, id: u32) -> bool {
-        let material = self.scene.scene.mesh.material_ids[id as usize];
-        self.lane_materials.get(material as usize) == Some(&true)
+        self.lane_materials.get(self.material_of(id) as usize) == Some(&true)
     }
 
     /// The linear colour [`Shader::shade`] gives each lane of `s`, and the
@@ -163,7 +162,7 @@ impl Shader<'_> {
             for k in 0..3 {
                 corners[k][l] = p[k];
             }
-            let material = &prepared.scene.materials[mesh.material_ids[id] as usize];
+            let material = &prepared.scene.materials[self.material_of(id as u32) as usize];
             base[l] = Vec3::from_slice(&material.base_color[..3]);
             emissive[l] = Vec3::from(material.emissive);
             if interpolated {

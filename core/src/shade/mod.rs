@@ -105,6 +105,17 @@ impl<'a> Shader<'a> {
         }
     }
 
+    /// Triangle `id`'s material: read from the mesh only when the scene has
+    /// more than one (a scene of one material — most scanned models — then
+    /// costs no per-sample read for it).
+    #[inline(always)]
+    fn material_of(&self, id: u32) -> u32 {
+        match self.scene.scene.materials.len() {
+            1 => 0,
+            _ => self.scene.scene.mesh.material_ids[id as usize],
+        }
+    }
+
     /// What this shader runs besides local shading.
     pub fn plan(&self) -> &EffectPlan {
         &self.plan
@@ -166,7 +177,7 @@ impl<'a> Shader<'a> {
         let point = origin + dir * t;
         let scene = &self.scene.scene;
         let mesh = &scene.mesh;
-        let material = &scene.materials[mesh.material_ids[id as usize] as usize];
+        let material = &scene.materials[self.material_of(id) as usize];
         let textured = material.base_color_texture.is_some() && !mesh.uvs.is_empty();
         // The §3.2 barycentrics, once per sample, when normals, texture
         // coordinates or vertex colours are interpolated.
