@@ -179,10 +179,7 @@ impl PreparedScene {
     /// The vertex positions of triangle `id` (any id, degenerate ones too).
     #[inline(always)]
     pub fn triangle(&self, id: u32) -> [Vec3; 3] {
-        match self.slot_of[id as usize] {
-            NO_SLOT => self.scene.mesh.triangle_positions(id as usize),
-            slot => self.slot_corners[slot as usize],
-        }
+        self.corners_and_vertices(id).0
     }
 
     /// Triangle `id`'s vertex positions and vertex indices, read from the
