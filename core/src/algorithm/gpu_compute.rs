@@ -38,7 +38,7 @@ use crate::screen_boxes::ScreenBoxes;
 use crate::stats::Stats;
 
 /// Rows of pixels per resolve band.
-const BAND: u32 = 16;
+pub(super) const BAND: u32 = 16;
 
 /// Renders with the compute kernels of `kind`, then resolves and shades.
 pub(crate) fn render_compute(

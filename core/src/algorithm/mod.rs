@@ -131,7 +131,7 @@ pub(crate) fn run(
         Pipeline::Rays => {
             raycast::render_raycast(scene, context, fb, stats, Triangle3D::setup_eight)
         }
-        Pipeline::Gpu => return render_gpu(scene, context, fb, stats).map(|()| None),
+        Pipeline::Gpu => render_gpu(scene, context, fb, stats)?,
         Pipeline::Compute(kind) => compute(scene, kind, context, fb, stats)?,
     };
     stats.time_ms.store += pass.store_ms;
@@ -148,16 +148,57 @@ pub(crate) const NO_GPU_FEATURE: &str =
     "the GPU algorithms need continuum built with the `gpu` feature";
 
 /// `gpu-raster`: one sample per pixel through the hardware pipeline, read
-/// back and resolved by the CPU's resolve.
+/// back and resolved by the CPU's resolve, in bands of rows in parallel as
+/// the compute kernels' samples are.
 #[cfg(feature = "gpu")]
 fn render_gpu(
     scene: &PreparedScene,
     context: &TileContext,
     fb: &mut Framebuffer,
     stats: &mut Stats,
-) -> Result<(), FieldError> {
-    crate::gpu::render_gpu_raster(scene, context.view, &context.shader, fb, stats)
-        .map_err(|e| FieldError::new(e.field(), e.to_string()))
+) -> Result<Pass, FieldError> {
+    let view = context.view;
+    let samples = crate::gpu::draw_gpu_raster(scene, view, stats)
+        .map_err(|e| FieldError::new(e.field(), e.to_string()))?;
+    let start = Instant::now();
+    let mut pass = Pass::default();
+    let rects = fb.tile_rects(view.width, gpu_compute::BAND);
+    let done: Vec<_> = pass
+        .planes(fb, &rects)
+        .into_par_iter()
+        .map_init(
+            || None,
+            |cache, planes| {
+                context.run_tile(cache, planes, |tile| {
+                    copy_drawn(&samples, tile, view.width);
+                    Default::default()
+                })
+            },
+        )
+        .collect();
+    pass.add(done);
+    let [_, resolve, shading] = pass.split(start);
+    (stats.time_ms.resolve, stats.time_ms.shading) = (resolve, shading);
+    Ok(pass)
+}
+
+/// The rows of `tile` from `gpu-raster`'s frame-sized read-back: triangle
+/// id, depth, and the fragments drawn as coverage writes.
+#[cfg(feature = "gpu")]
+fn copy_drawn(samples: &crate::gpu::Samples, tile: &mut TileBuffer, width: u32) {
+    let (x0, x1) = (tile.x0 as usize, tile.x1 as usize);
+    for y in tile.y0..tile.y1 {
+        let (from, to) = (y as usize * width as usize + x0, tile.index(tile.x0, y));
+        let n = x1 - x0;
+        tile.triangle_id[to..to + n].copy_from_slice(&samples.triangle_id[from..from + n]);
+        tile.depth[to..to + n].copy_from_slice(&samples.depth[from..from + n]);
+        for (out, &count) in tile.coverage_writes[to..to + n]
+            .iter_mut()
+            .zip(&samples.fragments[from..from + n])
+        {
+            *out = u32::from(count);
+        }
+    }
 }
 
 #[cfg(not(feature = "gpu"))]
@@ -166,7 +207,7 @@ fn render_gpu(
     _: &TileContext,
     _: &mut Framebuffer,
     _: &mut Stats,
-) -> Result<(), FieldError> {
+) -> Result<Pass, FieldError> {
     Err(FieldError::new("algorithm", NO_GPU_FEATURE))
 }
 

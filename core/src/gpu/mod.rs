@@ -22,11 +22,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 use crate::camera::View;
-use crate::framebuffer::{Framebuffer, TileBuffer};
-use crate::ground::PixelRect;
 use crate::prepared::PreparedScene;
-use crate::resolve::finish_tile;
-use crate::shade::Shader;
 use crate::stats::Stats;
 
 pub use compute::GpuAtomics;
@@ -653,15 +649,14 @@ fn camera_uniform(view: &View, far: f32) -> CameraUniform {
     }
 }
 
-/// `gpu-raster`: draws `view` of `scene` on the GPU and resolves the result
-/// into `fb` with the CPU's shading. Planar viewports, one sample per pixel.
-pub(crate) fn render_gpu_raster(
+/// `gpu-raster`'s draw: `view` of `scene` through the GPU's pipeline, read
+/// back (planar viewports, one sample per pixel); the caller resolves and
+/// shades it as every algorithm's samples are.
+pub(crate) fn draw_gpu_raster(
     scene: &PreparedScene,
     view: &View,
-    shader: &Shader,
-    fb: &mut Framebuffer,
     stats: &mut Stats,
-) -> Result<(), GpuError> {
+) -> Result<Samples, GpuError> {
     let gpu = gpu()?;
     // 1. Setup: the scene's vertices on the device (once per prepared scene).
     let start = Instant::now();
@@ -673,23 +668,7 @@ pub(crate) fn render_gpu_raster(
     let far = orthographic_far(scene, view);
     let samples = gpu.draw(mesh, view, far)?;
     stats.time_ms.coverage = start.elapsed().as_secs_f64() * 1e3;
-    // 3. Resolve and shade on the CPU, as every algorithm does: the read-back
-    // is one tile of the whole frame.
-    let start = Instant::now();
-    let pattern = crate::AaMode::None.pattern();
-    let whole = PixelRect::new(0, 0, view.width, view.height);
-    let mut tile = TileBuffer::new(whole, &pattern, &[]);
-    tile.triangle_id = samples.triangle_id;
-    tile.depth = samples.depth;
-    tile.coverage_writes = samples.fragments.into_iter().map(u32::from).collect();
-    let mut planes = fb.tile_planes(&[whole]).pop().expect("one tile");
-    stats.time_ms.store += start.elapsed().as_secs_f64() * 1e3;
-    let (totals, [resolve, shading]) = finish_tile(&tile, view, shader, &mut planes);
-    stats.coverage_histogram = totals.histogram;
-    stats.effects = totals.effects.report(shader.plan(), &scene.scene);
-    stats.shading_samples = totals.shading_samples;
-    (stats.time_ms.resolve, stats.time_ms.shading) = (resolve * 1e3, shading * 1e3);
-    Ok(())
+    Ok(samples)
 }
 
 /// The far distance for an orthographic view's depth range: beyond the scene's
