@@ -596,33 +596,27 @@ impl Gpu {
         device
             .poll(wgpu::PollType::wait_indefinitely())
             .map_err(|e| GpuError::Failed(e.to_string()))?;
-        let texels =
-            |(buffer, row): &(wgpu::Buffer, u32), texel: usize| -> Result<Vec<u8>, GpuError> {
-                let mapped = buffer
-                    .get_mapped_range(..)
-                    .map_err(|e| GpuError::Failed(e.to_string()))?;
-                let mut out = Vec::with_capacity(width as usize * height as usize * texel);
-                for r in mapped.chunks(*row as usize) {
-                    out.extend_from_slice(&r[..width as usize * texel]);
-                }
-                Ok(out)
-            };
-        let words = |bytes: Vec<u8>| -> Vec<[u8; 4]> {
-            bytes
-                .chunks_exact(4)
-                .map(|c| [c[0], c[1], c[2], c[3]])
-                .collect()
-        };
+        // Each plane decoded in one pass over its padded rows.
+        fn plane<T, const N: usize>(
+            (buffer, row): &(wgpu::Buffer, u32),
+            (width, height): (u32, u32),
+            decode: fn([u8; N]) -> T,
+        ) -> Result<Vec<T>, GpuError> {
+            let mapped = buffer
+                .get_mapped_range(..)
+                .map_err(|e| GpuError::Failed(e.to_string()))?;
+            let mut out = Vec::with_capacity(width as usize * height as usize);
+            for r in mapped.chunks(*row as usize) {
+                let texels = r[..width as usize * N].as_chunks::<N>().0;
+                out.extend(texels.iter().map(|&t| decode(t)));
+            }
+            Ok(out)
+        }
+        let size = (width, height);
         Ok(Samples {
-            triangle_id: words(texels(&id_buffer, 4)?)
-                .into_iter()
-                .map(u32::from_le_bytes)
-                .collect(),
-            depth: words(texels(&w_buffer, 4)?)
-                .into_iter()
-                .map(f32::from_le_bytes)
-                .collect(),
-            fragments: texels(&count_buffer, 1)?,
+            triangle_id: plane(&id_buffer, size, u32::from_le_bytes)?,
+            depth: plane(&w_buffer, size, f32::from_le_bytes)?,
+            fragments: plane(&count_buffer, size, |[count]: [u8; 1]| count)?,
         })
     }
 }
