@@ -29,7 +29,7 @@ use super::{Pass, TileContext, setup2d};
 use crate::aa::SamplePattern;
 use crate::camera::View;
 use crate::edge::{Coverage, HomogeneousVertex, Triangle3D, setup_homogeneous_from};
-use crate::framebuffer::{Framebuffer, wins_depth_test};
+use crate::framebuffer::{Framebuffer, TileBuffer, wins_depth_test};
 use crate::gpu::{ComputeSamples, TriWords, atomics, gpu};
 use crate::ground::{FieldError, PixelRect, SampleSpan};
 use crate::pipeline::ComputeKind;
@@ -38,7 +38,7 @@ use crate::screen_boxes::ScreenBoxes;
 use crate::stats::Stats;
 
 /// Rows of pixels per resolve band.
-pub(super) const BAND: u32 = 16;
+const BAND: u32 = 16;
 
 /// Renders with the compute kernels of `kind`, then resolves and shades.
 pub(crate) fn render_compute(
@@ -94,8 +94,26 @@ pub(crate) fn render_compute(
     // Resolve and shade in bands of rows, in parallel, from the frame-sized
     // read-back.
     let start = Instant::now();
+    let mut pass = resolve_bands(context, fb, |tile| {
+        copy_band(&samples, tile, view.width, view.height);
+    });
+    let c = &mut pass.counters;
+    [c.tiles_tested, c.tiles_accepted, c.tiles_rejected] = samples.tiles;
+    [c.edge_tests_f64, c.edge_tests_exact] = precise;
+    let [_, resolve, shading] = pass.split(start);
+    (stats.time_ms.resolve, stats.time_ms.shading) = (resolve, shading);
+    Ok(pass)
+}
+
+/// A frame-sized read-back resolved and shaded in bands of [`BAND`] rows in
+/// parallel, `copy` filling each band's tile from it.
+pub(super) fn resolve_bands(
+    context: &TileContext,
+    fb: &mut Framebuffer,
+    copy: impl Fn(&mut TileBuffer) + Sync,
+) -> Pass {
     let mut pass = Pass::default();
-    let rects = fb.tile_rects(view.width, BAND);
+    let rects = fb.tile_rects(context.view.width, BAND);
     let done: Vec<_> = pass
         .planes(fb, &rects)
         .into_par_iter()
@@ -103,19 +121,14 @@ pub(crate) fn render_compute(
             || None,
             |cache, planes| {
                 context.run_tile(cache, planes, |tile| {
-                    copy_band(&samples, tile, view.width, view.height);
+                    copy(tile);
                     Default::default()
                 })
             },
         )
         .collect();
     pass.add(done);
-    let c = &mut pass.counters;
-    [c.tiles_tested, c.tiles_accepted, c.tiles_rejected] = samples.tiles;
-    [c.edge_tests_f64, c.edge_tests_exact] = precise;
-    let [_, resolve, shading] = pass.split(start);
-    (stats.time_ms.resolve, stats.time_ms.shading) = (resolve, shading);
-    Ok(pass)
+    pass
 }
 
 /// A set-up triangle's GPU record (`Tri` in compute.wgsl): its rows, then
@@ -223,12 +236,7 @@ fn decide_unsure(
 }
 
 /// The tile's samples from the frame-sized, layer-major read-back.
-fn copy_band(
-    samples: &ComputeSamples,
-    tile: &mut crate::framebuffer::TileBuffer,
-    width: u32,
-    height: u32,
-) {
+fn copy_band(samples: &ComputeSamples, tile: &mut TileBuffer, width: u32, height: u32) {
     let frame = width as usize * height as usize;
     let (x0, x1) = (tile.x0 as usize, tile.x1 as usize);
     for y in tile.y0..tile.y1 {

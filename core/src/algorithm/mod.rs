@@ -161,22 +161,8 @@ fn render_gpu(
     let samples = crate::gpu::draw_gpu_raster(scene, view, stats)
         .map_err(|e| FieldError::new(e.field(), e.to_string()))?;
     let start = Instant::now();
-    let mut pass = Pass::default();
-    let rects = fb.tile_rects(view.width, gpu_compute::BAND);
-    let done: Vec<_> = pass
-        .planes(fb, &rects)
-        .into_par_iter()
-        .map_init(
-            || None,
-            |cache, planes| {
-                context.run_tile(cache, planes, |tile| {
-                    copy_drawn(&samples, tile, view.width);
-                    Default::default()
-                })
-            },
-        )
-        .collect();
-    pass.add(done);
+    let pass =
+        gpu_compute::resolve_bands(context, fb, |tile| copy_drawn(&samples, tile, view.width));
     let [_, resolve, shading] = pass.split(start);
     (stats.time_ms.resolve, stats.time_ms.shading) = (resolve, shading);
     Ok(pass)
