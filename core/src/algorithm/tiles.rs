@@ -6,6 +6,7 @@ use rayon::prelude::*;
 
 use super::{Pass, PixelRect, TileContext};
 use crate::framebuffer::{Framebuffer, TileBuffer};
+use crate::simd;
 use crate::stats::RasterCounters;
 
 /// Side of a screen tile in pixels.
@@ -108,8 +109,14 @@ pub(crate) fn rasterize_tiled<T: Sync>(
             |cache, (t, planes)| {
                 context.run_tile(cache, planes, |tile| {
                     let mut counters = RasterCounters::default();
-                    let members = runs.iter().flat_map(|run| run.of(t));
-                    for &k in members {
+                    let mut members = runs.iter().flat_map(|run| run.of(t)).peekable();
+                    while let Some(&k) = members.next() {
+                        // The next item's records are on their way while this
+                        // one is rasterized (they are far apart in memory).
+                        if let Some(&&next) = members.peek() {
+                            simd::prefetch(&items.boxes[next as usize]);
+                            simd::prefetch(&items.triangles[next as usize]);
+                        }
                         // Only items with a box (and so a triangle) were sorted into tiles.
                         let k = k as usize;
                         let (Some((rect, id)), Some(tri)) = (items.boxes[k], &items.triangles[k])
