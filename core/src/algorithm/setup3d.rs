@@ -15,6 +15,7 @@ use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
 use crate::screen_boxes::ScreenBoxes;
+use crate::simd;
 
 /// Every drawable triangle with samples on screen, set up with 3D edge functions.
 pub(crate) fn setup_3d<'a>(
@@ -166,7 +167,15 @@ fn setup_visible<'a, T: Send>(
 ) -> Setups<T> {
     let boxes = ScreenBoxes::new(scene, view);
     let corners = &scene.scene.mesh.triangles;
-    let eights = (scene.drawable.par_chunks(8)).map(|ids| {
+    let eights = (scene.drawable.par_chunks(8).enumerate()).map(|(chunk, ids)| {
+        // The slot-ordered corners are scattered in id order: the next
+        // eight triangles' are on their way while these are set up.
+        let next = scene.drawable.get((chunk + 1) * 8..).unwrap_or_default();
+        for &id in next.iter().take(8) {
+            if let Some(corners) = scene.slot_corners.get(scene.slot_of[id as usize] as usize) {
+                simd::prefetch(corners);
+            }
+        }
         let id = lanes_of(ids).map(|&id| id as usize);
         let mut eight = EightTriangles {
             corners: id.map(|id| &scene.slot_corners[scene.slot_of[id] as usize]),
