@@ -309,4 +309,6 @@ pub(crate) fn prefetch<T>(value: &T) {
             unsafe { _mm_prefetch::<_MM_HINT_T0>(first.wrapping_add(offset)) };
         }
     }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = value;
 }
