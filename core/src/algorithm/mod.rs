@@ -178,12 +178,7 @@ fn copy_drawn(samples: &crate::gpu::Samples, tile: &mut TileBuffer, width: u32) 
         let n = x1 - x0;
         tile.triangle_id[to..to + n].copy_from_slice(&samples.triangle_id[from..from + n]);
         tile.depth[to..to + n].copy_from_slice(&samples.depth[from..from + n]);
-        for (out, &count) in tile.coverage_writes[to..to + n]
-            .iter_mut()
-            .zip(&samples.fragments[from..from + n])
-        {
-            *out = u32::from(count);
-        }
+        tile.coverage_writes[to..to + n].copy_from_slice(&samples.fragments[from..from + n]);
     }
 }
 

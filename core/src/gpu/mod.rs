@@ -616,7 +616,7 @@ impl Gpu {
         Ok(Samples {
             triangle_id: plane(&id_buffer, size, u32::from_le_bytes)?,
             depth: plane(&w_buffer, size, f32::from_le_bytes)?,
-            fragments: plane(&count_buffer, size, |[count]: [u8; 1]| count)?,
+            fragments: plane(&count_buffer, size, |[count]: [u8; 1]| u32::from(count))?,
         })
     }
 }
@@ -626,8 +626,8 @@ impl Gpu {
 pub(crate) struct Samples {
     pub triangle_id: Vec<u32>,
     pub depth: Vec<f32>,
-    /// Fragments per pixel (clamped at 255).
-    pub fragments: Vec<u8>,
+    /// Fragments per pixel (the stencil count: at most 255).
+    pub fragments: Vec<u32>,
 }
 
 /// The camera of `view` for the shader; `far` bounds orthographic depth.
