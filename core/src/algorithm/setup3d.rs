@@ -7,10 +7,7 @@ use rayon::prelude::*;
 
 use super::tiles::{ItemBox, Setups};
 use crate::camera::View;
-use crate::edge::{
-    CurvedTriangle, EightTriangles, HomogeneousVertex, Triangle3D, Triangle3D64,
-    setup_homogeneous_from,
-};
+use crate::edge::{CurvedTriangle, EightTriangles, HomogeneousVertex, Triangle3D, Triangle3D64};
 use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
@@ -57,10 +54,7 @@ pub(crate) fn setup_homogeneous<'a>(
         .map(|&p| HomogeneousVertex::of(p, view))
         .collect();
     let setup = |t: &EightTriangles<'a>, view: &'a View| {
-        t.each(|l| {
-            let vertices = t.vertices[l].map(|v| points[v as usize]);
-            setup_homogeneous_from(t.corners[l], vertices, view)
-        })
+        Triangle3D::setup_homogeneous_eight(t, &points, view)
     };
     setup_visible(scene, view, span, setup)
 }

@@ -1,4 +1,5 @@
-//! [`Triangle3D::setup`] for eight perspective triangles at once (paper §3.2).
+//! [`Triangle3D::setup`] for eight perspective triangles at once (paper §3.2),
+//! and the homogeneous setup of Fig. 10 (middle) likewise.
 //!
 //! The setup is some 350 additions and multiplications per triangle and no
 //! data-dependent control flow but three rare branches: vertices so far away
@@ -7,12 +8,15 @@
 //! side, one per lane, in exactly the scalar operation order with no fused
 //! multiply-add (see [`crate::simd`]): every coefficient equals the scalar
 //! setup's bit for bit. A lane that meets one of the three branches is set up
-//! again by the scalar [`Triangle3D::setup`], which takes it.
+//! again by the scalar setup, which takes it.
 
 use glam::Vec3;
 
 use super::EightTriangles;
-use super::edge3d::{EPS, ExactEdges, ExactForm, SCALE_ABOVE, Triangle3D, image_extent};
+use super::edge3d::{
+    EPS, ExactEdges, ExactForm, HomogeneousVertex, SCALE_ABOVE, Triangle3D, image_extent,
+};
+use super::homogeneous::setup_homogeneous_from;
 use crate::camera::View;
 use crate::simd::{self, Lanes};
 
@@ -25,6 +29,50 @@ impl<'a> Triangle3D<'a> {
     ) -> [Option<Triangle3D<'a>>; 8] {
         setup_eight_with(t.corners, t.present, view, perspective_lanes)
     }
+
+    /// The triangles of `t` set up for homogeneous 2D rasterization from
+    /// their transformed vertices (`points`, indexed by `t.vertices`), each
+    /// exactly as [`setup_homogeneous_from`] sets it up.
+    pub(crate) fn setup_homogeneous_eight(
+        t: &EightTriangles<'a>,
+        points: &[HomogeneousVertex],
+        view: &'a View,
+    ) -> [Option<Triangle3D<'a>>; 8] {
+        homogeneous_eight_with(t, points, view, homogeneous_lanes)
+    }
+}
+
+/// [`Triangle3D::setup_homogeneous_eight`] with the lanes computed by `kernel`.
+#[inline(always)]
+fn homogeneous_eight_with<'a>(
+    t: &EightTriangles<'a>,
+    points: &[HomogeneousVertex],
+    view: &'a View,
+    kernel: fn(&Corners, &[[f32; 8]; 3], &View) -> LaneSetups,
+) -> [Option<Triangle3D<'a>>; 8] {
+    let vertices = |l: usize| t.vertices[l].map(|v| points[v as usize]);
+    if view.is_orthographic() {
+        return t.each(|l| setup_homogeneous_from(t.corners[l], vertices(l), view));
+    }
+    // Absent lanes stay at zero: degenerate, undecided.
+    let (mut h, mut w): (Corners, [[f32; 8]; 3]) = Default::default();
+    for l in 0..8 {
+        if t.present >> l & 1 == 1 {
+            for (v, vertex) in vertices(l).iter().enumerate() {
+                (h[v][0][l], h[v][1][l], h[v][2][l]) = (vertex.h.x, vertex.h.y, vertex.h.z);
+                w[v][l] = vertex.w;
+            }
+        }
+    }
+    let s = kernel(&h, &w, view);
+    assembled(
+        t.corners,
+        t.present,
+        &s,
+        ExactForm::Homogeneous,
+        view,
+        |l| setup_homogeneous_from(t.corners[l], vertices(l), view),
+    )
 }
 
 /// Vertex, axis, lane.
@@ -38,14 +86,12 @@ fn setup_eight_with<'a>(
     view: &'a View,
     kernel: fn(&Corners, &View) -> LaneSetups,
 ) -> [Option<Triangle3D<'a>>; 8] {
-    let mut out = [None; 8];
     if view.is_orthographic() {
-        for l in 0..8 {
-            if present >> l & 1 == 1 {
-                out[l] = Triangle3D::setup(p[l], view);
-            }
-        }
-        return out;
+        return std::array::from_fn(|l| {
+            (present >> l & 1 == 1)
+                .then(|| Triangle3D::setup(p[l], view))
+                .flatten()
+        });
     }
     // Absent lanes stay at zero: degenerate, undecided.
     let mut corners: Corners = [[[0.0; 8]; 3]; 3];
@@ -58,12 +104,29 @@ fn setup_eight_with<'a>(
         }
     }
     let s = kernel(&corners, view);
+    assembled(p, present, &s, ExactForm::Perspective, view, |l| {
+        Triangle3D::setup(p[l], view)
+    })
+}
+
+/// The present lanes' triangles from what the lanes computed: a decided
+/// lane's values as they are, an undecided one set up by `scalar`.
+#[inline(always)]
+fn assembled<'a>(
+    p: [&'a [Vec3; 3]; 8],
+    present: u8,
+    s: &LaneSetups,
+    form: ExactForm,
+    view: &'a View,
+    scalar: impl Fn(usize) -> Option<Triangle3D<'a>>,
+) -> [Option<Triangle3D<'a>>; 8] {
+    let mut out = [None; 8];
     for l in 0..8 {
         if present >> l & 1 == 0 {
             continue;
         }
         if s.decided >> l & 1 == 0 {
-            out[l] = Triangle3D::setup(p[l], view);
+            out[l] = scalar(l);
             continue;
         }
         let edge = |j: usize| [s.edges[0][j][l], s.edges[1][j][l], s.edges[2][j][l]];
@@ -77,13 +140,13 @@ fn setup_eight_with<'a>(
             w_range: [w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2])],
             near: view.near,
             tolerance: [s.tolerance[0][l], s.tolerance[1][l], s.tolerance[2][l]],
-            exact: ExactEdges::new(ExactForm::Perspective, p[l], view, s.negated >> l & 1 == 1),
+            exact: ExactEdges::new(form, p[l], view, s.negated >> l & 1 == 1),
         });
     }
     out
 }
 
-/// What eight lanes of the perspective setup computed, lane last.
+/// What eight lanes of a setup computed, lane last.
 struct LaneSetups {
     /// Per edge, its `[A, B, C]`.
     edges: [[[f32; 8]; 3]; 3],
@@ -268,13 +331,7 @@ fn perspective_lanes_on<L: Lanes>(corners: &Corners, view: &View) -> LaneSetups 
     let d_bound = L::splat(16.0 * EPS) * e1.abs_cross(e2).dot(c0.abs());
     let positive = d.gt(d_bound);
     let negative = d.lt(L::splat(0.0) - d_bound);
-    let mut signs = [-1.0; 8];
-    for (l, s) in signs.iter_mut().enumerate() {
-        if positive >> l & 1 == 1 {
-            *s = 1.0;
-        }
-    }
-    let sign = L::from_array(signs);
+    let sign = signs(positive);
     // 4. The three edges (edge i opposite vertex i) and their tolerances.
     let extent = image_extent(view);
     let d_abs = view.d0.abs() + view.dx.abs() * extent.0 + view.dy.abs() * extent.1;
@@ -303,6 +360,93 @@ fn perspective_lanes_on<L: Lanes>(corners: &Corners, view: &View) -> LaneSetups 
         negated: !positive,
         decided: unscaled & (positive | negative) & finite,
     }
+}
+
+simd::dispatch! {
+    /// [`homogeneous_lanes_on`] on the lanes of this CPU.
+    fn homogeneous_lanes<>(h: &Corners, w: &[[f32; 8]; 3], view: &View) -> LaneSetups => homogeneous_lanes_on
+}
+
+/// The lanes of [`setup_homogeneous_from`]'s perspective branch, step for
+/// step, on vertices `h` in homogeneous pixel coordinates with view-axis
+/// distances `w`.
+#[inline(always)]
+fn homogeneous_lanes_on<L: Lanes>(h: &Corners, w: &[[f32; 8]; 3], view: &View) -> LaneSetups {
+    let (h0, h1, h2) = (V::<L>::load(&h[0]), V::load(&h[1]), V::load(&h[2]));
+    // 1. Lanes that `scaled` would scale are left to the scalar setup.
+    let largest = (h0.abs().max_element())
+        .max(h1.abs().max_element())
+        .max(h2.abs().max_element());
+    let unscaled = largest.le(L::splat(SCALE_ABOVE));
+    // 2. The determinant and its certain signs (uncertain ones: the scalar setup).
+    let (e1, e2) = (h1.sub(h0), h2.sub(h0));
+    let normal = e1.cross(e2);
+    let det = normal.dot(h0);
+    let det_bound = L::splat(16.0 * EPS) * e1.abs_cross(e2).dot(h0.abs());
+    let positive = det.gt(det_bound);
+    let negative = det.lt(L::splat(0.0) - det_bound);
+    let sign = signs(positive);
+    // 3. The rows of the adjugate (edge i opposite vertex i) and their tolerances.
+    let extent = image_extent(view);
+    let (edge0, r0) = row_lanes(h1, h2, sign, extent);
+    let (edge1, r1) = row_lanes(h2, h0, sign, extent);
+    let (edge2, r2) = row_lanes(h0, h1, sign, extent);
+    let nd = linear(normal, sign);
+    let volume = abs(det);
+    let tolerances = [
+        tolerance(edge0, r0, extent),
+        tolerance(edge1, r1, extent),
+        tolerance(edge2, r2, extent),
+    ];
+    let w = [
+        L::from_array(w[0]),
+        L::from_array(w[1]),
+        L::from_array(w[2]),
+    ];
+    // 4. Finite everywhere (non-finite lanes: the scalar setup says `None`).
+    let mut nan = volume * L::splat(0.0);
+    for values in [edge0, edge1, edge2, nd, tolerances, w] {
+        nan = add_nan_if_not_finite(nan, values);
+    }
+    let finite = nan.eq(L::splat(0.0));
+    LaneSetups {
+        edges: [arrays(edge0), arrays(edge1), arrays(edge2)],
+        nd: arrays(nd),
+        volume: volume.to_array(),
+        w: arrays(w),
+        tolerance: arrays(tolerances),
+        negated: !positive,
+        decided: unscaled & (positive | negative) & finite,
+    }
+}
+
+/// The homogeneous edge function of edge `(a, b)`, the adjugate's row
+/// `((a + b)·½) × (b − a)` oriented by `sign`, and its coefficient error
+/// bound: 6ε of `|m| ⊗ |u|` at the image's far corner.
+#[inline(always)]
+fn row_lanes<L: Lanes>(a: V<L>, b: V<L>, sign: L, (x_max, y_max): (f32, f32)) -> ([L; 3], L) {
+    let (m, u) = (a.add(b).scale(L::splat(0.5)), b.sub(a));
+    let t = m.abs_cross(u);
+    let error = L::splat(6.0 * EPS) * (t.z + L::splat(x_max) * t.x + L::splat(y_max) * t.y);
+    (linear(m.cross(u), sign), error)
+}
+
+/// `[r.z, r.x, r.y]` times `sign`: a row as a linear function of the pixel.
+#[inline(always)]
+fn linear<L: Lanes>(r: V<L>, sign: L) -> [L; 3] {
+    [r.z * sign, r.x * sign, r.y * sign]
+}
+
+/// `+1` in the lanes of `positive`, `−1` in the others.
+#[inline(always)]
+fn signs<L: Lanes>(positive: u8) -> L {
+    let mut signs = [-1.0; 8];
+    for (l, s) in signs.iter_mut().enumerate() {
+        if positive >> l & 1 == 1 {
+            *s = 1.0;
+        }
+    }
+    L::from_array(signs)
 }
 
 #[cfg(test)]
@@ -400,6 +544,66 @@ mod tests {
         // Half the cases are edge-on or degenerate and a fifth of the rest
         // are scaled (the scalar fallback's); most others take the lanes.
         assert!(in_lanes > 8_000, "{in_lanes} set up in lanes");
+    }
+
+    /// Every lane of `kernel`'s eight-at-once homogeneous setup equals the
+    /// scalar one, on all lanes or some, with triangles through the eye plane
+    /// as well (no clipping: the signs handle them).
+    fn homogeneous_lanes_set_up_as_the_scalar_setup(
+        kernel: fn(&Corners, &[[f32; 8]; 3], &View) -> LaneSetups,
+    ) {
+        let mut rng = fastrand::Rng::with_seed(12);
+        let (mut checked, mut set_up) = (0, 0);
+        for view in views() {
+            let mut tris = triangles(&view, &mut rng);
+            let behind: Vec<[Vec3; 3]> = (tris.iter())
+                .map(|&[a, b, c]| [a, b, view.eye - (c - view.eye)])
+                .collect();
+            tris.extend(behind);
+            let points: Vec<HomogeneousVertex> = (tris.iter().flatten())
+                .map(|&p| HomogeneousVertex::of(p, &view))
+                .collect();
+            for (k, chunk) in tris.chunks(8).enumerate() {
+                let lane = |l: usize| 8 * k + l % chunk.len();
+                let t = EightTriangles {
+                    corners: std::array::from_fn(|l| &tris[lane(l)]),
+                    vertices: std::array::from_fn(|l| [0, 1, 2].map(|v| (3 * lane(l) + v) as u32)),
+                    present: if k % 3 == 0 { 0b1011_0110 } else { 0xff },
+                };
+                let lanes = homogeneous_eight_with(&t, &points, &view, kernel);
+                for l in 0..8 {
+                    let vertices = t.vertices[l].map(|v| points[v as usize]);
+                    let scalar = (t.present >> l & 1 == 1)
+                        .then(|| setup_homogeneous_from(t.corners[l], vertices, &view))
+                        .flatten();
+                    assert!(
+                        same(&lanes[l], &scalar),
+                        "{:?}: lanes {:?}, scalar {scalar:?}",
+                        t.corners[l],
+                        lanes[l]
+                    );
+                    checked += 1;
+                    set_up += usize::from(scalar.is_some());
+                }
+            }
+        }
+        assert_eq!(checked, 2 * 2 * 16_000);
+        assert!(set_up > 16_000, "{set_up} set up");
+    }
+
+    #[test]
+    fn portable_homogeneous_lanes_set_up_as_the_scalar_setup() {
+        homogeneous_lanes_set_up_as_the_scalar_setup(homogeneous_lanes_on::<simd::Portable>);
+    }
+
+    #[test]
+    fn avx2_homogeneous_lanes_set_up_as_the_scalar_setup() {
+        #[cfg(target_arch = "x86_64")]
+        assert!(
+            simd::cpu_has_avx2(),
+            "this test checks the AVX2 kernel, and this CPU has no AVX2"
+        );
+        homogeneous_lanes_set_up_as_the_scalar_setup(homogeneous_lanes);
     }
 
     #[test]

@@ -28,6 +28,9 @@ pub(crate) use edge3d::EPS;
 pub(crate) use edge3d::HomogeneousVertex;
 pub use edge3d::Triangle3D;
 pub use edge3d_f64::Triangle3D64;
+// The GPU's exact fallback sets up one triangle at a time; the CPU, eight
+// (`Triangle3D::setup_homogeneous_eight`).
+#[cfg(feature = "gpu")]
 pub(crate) use homogeneous::setup_homogeneous_from;
 
 thread_local! {
