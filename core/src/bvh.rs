@@ -194,8 +194,8 @@ impl SceneBvh {
     /// origin (every perspective and spherical view) are tested together by
     /// [`PacketInterval`], one 8-lane test per node for the whole packet;
     /// others ray by ray. `leaf(slot, cull)` is called for each primitive slot
-    /// of every leaf the packet reaches and updates each lane's culling
-    /// distance in `cull`. Returns the number of nodes whose children were
+    /// of every leaf the packet reaches, updates each lane's culling
+    /// distance in `cull` and says whether it changed any. Returns the number of nodes whose children were
     /// tested (once per node, for the packet), and adds their indices to
     /// `entered` when given (a render's trace). The slab tests run on lanes `L`
     /// (the caller's instruction set, see [`crate::simd`]; inlined into it).
@@ -204,7 +204,7 @@ impl SceneBvh {
         &self,
         rays: PacketRays,
         mut entered: Option<&mut Vec<u32>>,
-        mut leaf: impl FnMut(u32, &mut [f32; PACKET]),
+        mut leaf: impl FnMut(u32, &mut [f32; PACKET]) -> bool,
     ) -> u64 {
         if self.cwbvh.nodes.is_empty() {
             return 0;
@@ -275,10 +275,13 @@ impl SceneBvh {
                 child_mask(node, hits, state.oct_inv4)
             },
             {
-                leaf(state.primitive_id, &mut cull);
-                tmax = f32::NEG_INFINITY;
-                for &c in &cull {
-                    tmax = tmax.max(c);
+                // Most leaf triangles miss every ray: the packet's culling
+                // distance is renewed only when a hit moved one.
+                if leaf(state.primitive_id, &mut cull) {
+                    tmax = f32::NEG_INFINITY;
+                    for &c in &cull {
+                        tmax = tmax.max(c);
+                    }
                 }
             }
         );

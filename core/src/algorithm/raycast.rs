@@ -168,16 +168,17 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                 nodes += scene.bvh.walk_packet::<L>(packet, entered, |k, cull| {
                     // The box first: most leaf triangles miss a packet's block.
                     let Some((rect, id)) = setups.boxes[k as usize] else {
-                        return;
+                        return false;
                     };
                     let inside = block_mask(rect, x, y);
                     if cast & inside == 0 {
-                        return;
+                        return false;
                     }
                     let Some(tri) = &setups.triangles[k as usize] else {
-                        return;
+                        return false;
                     };
                     let see_through = is_see_through(opacity, id);
+                    let mut moved = false;
                     for half in 0..HALVES {
                         let active = ((cast & inside) >> (8 * half)) as u8;
                         if active == 0 {
@@ -203,9 +204,11 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                             } else if wins_depth_test(w, id, best[lane].0, best[lane].1) {
                                 best[lane] = (w, id, k);
                                 cull[lane] = w * CULL_MARGIN;
+                                moved = true;
                             }
                         }
                     }
+                    moved
                 });
                 for l in 0..PACKET {
                     if cast >> l & 1 == 0 {
