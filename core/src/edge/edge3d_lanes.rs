@@ -317,49 +317,18 @@ fn perspective_lanes_on<L: Lanes>(corners: &Corners, view: &View) -> LaneSetups 
         c1.dot_with(view.forward),
         c2.dot_with(view.forward),
     ];
-    // 2. Lanes that `scaled` would scale are left to the scalar setup.
-    let largest = c0
-        .abs()
-        .max_element()
-        .max(c1.abs().max_element())
-        .max(c2.abs().max_element());
-    let unscaled = largest.le(L::splat(SCALE_ABOVE));
-    // 3. The volume and its certain signs (uncertain ones: the scalar setup).
-    let (e1, e2) = (c1.sub(c0), c2.sub(c0));
-    let normal = e1.cross(e2);
-    let d = normal.dot(c0);
-    let d_bound = L::splat(16.0 * EPS) * e1.abs_cross(e2).dot(c0.abs());
-    let positive = d.gt(d_bound);
-    let negative = d.lt(L::splat(0.0) - d_bound);
-    let sign = signs(positive);
-    // 4. The three edges (edge i opposite vertex i) and their tolerances.
+    // 2. The volume D = N·c0 and its certain signs.
+    let o = Orientation::of(c0, c1, c2);
+    // 3. The three edges (edge i opposite vertex i) and their errors.
     let extent = image_extent(view);
     let d_abs = view.d0.abs() + view.dx.abs() * extent.0 + view.dy.abs() * extent.1;
-    let (edge0, r0) = edge_lanes(c1, c2, sign, d_abs, view);
-    let (edge1, r1) = edge_lanes(c2, c0, sign, d_abs, view);
-    let (edge2, r2) = edge_lanes(c0, c1, sign, d_abs, view);
-    let nd = normal.scale(sign).along(view);
-    let volume = abs(d);
-    let tolerances = [
-        tolerance(edge0, r0, extent),
-        tolerance(edge1, r1, extent),
-        tolerance(edge2, r2, extent),
+    let edges = [
+        edge_lanes(c1, c2, o.sign, d_abs, view),
+        edge_lanes(c2, c0, o.sign, d_abs, view),
+        edge_lanes(c0, c1, o.sign, d_abs, view),
     ];
-    // 5. Finite everywhere (non-finite lanes: the scalar setup says `None`).
-    let mut nan = volume * L::splat(0.0);
-    for values in [edge0, edge1, edge2, nd, tolerances, w] {
-        nan = add_nan_if_not_finite(nan, values);
-    }
-    let finite = nan.eq(L::splat(0.0));
-    LaneSetups {
-        edges: [arrays(edge0), arrays(edge1), arrays(edge2)],
-        nd: arrays(nd),
-        volume: volume.to_array(),
-        w: arrays(w),
-        tolerance: arrays(tolerances),
-        negated: !positive,
-        decided: unscaled & (positive | negative) & finite,
-    }
+    let nd = o.normal.scale(o.sign).along(view);
+    finished(edges, nd, w, &o, extent)
 }
 
 simd::dispatch! {
@@ -373,38 +342,82 @@ simd::dispatch! {
 #[inline(always)]
 fn homogeneous_lanes_on<L: Lanes>(h: &Corners, w: &[[f32; 8]; 3], view: &View) -> LaneSetups {
     let (h0, h1, h2) = (V::<L>::load(&h[0]), V::load(&h[1]), V::load(&h[2]));
-    // 1. Lanes that `scaled` would scale are left to the scalar setup.
-    let largest = (h0.abs().max_element())
-        .max(h1.abs().max_element())
-        .max(h2.abs().max_element());
-    let unscaled = largest.le(L::splat(SCALE_ABOVE));
-    // 2. The determinant and its certain signs (uncertain ones: the scalar setup).
-    let (e1, e2) = (h1.sub(h0), h2.sub(h0));
-    let normal = e1.cross(e2);
-    let det = normal.dot(h0);
-    let det_bound = L::splat(16.0 * EPS) * e1.abs_cross(e2).dot(h0.abs());
-    let positive = det.gt(det_bound);
-    let negative = det.lt(L::splat(0.0) - det_bound);
-    let sign = signs(positive);
-    // 3. The rows of the adjugate (edge i opposite vertex i) and their tolerances.
+    // 1. The determinant det[h0, h1, h2] = N·h0 and its certain signs.
+    let o = Orientation::of(h0, h1, h2);
+    // 2. The rows of the adjugate (edge i opposite vertex i) and their errors.
     let extent = image_extent(view);
-    let (edge0, r0) = row_lanes(h1, h2, sign, extent);
-    let (edge1, r1) = row_lanes(h2, h0, sign, extent);
-    let (edge2, r2) = row_lanes(h0, h1, sign, extent);
-    let nd = linear(normal, sign);
-    let volume = abs(det);
-    let tolerances = [
-        tolerance(edge0, r0, extent),
-        tolerance(edge1, r1, extent),
-        tolerance(edge2, r2, extent),
+    let edges = [
+        row_lanes(h1, h2, o.sign, extent),
+        row_lanes(h2, h0, o.sign, extent),
+        row_lanes(h0, h1, o.sign, extent),
     ];
+    let nd = linear(o.normal, o.sign);
     let w = [
         L::from_array(w[0]),
         L::from_array(w[1]),
         L::from_array(w[2]),
     ];
-    // 4. Finite everywhere (non-finite lanes: the scalar setup says `None`).
-    let mut nan = volume * L::splat(0.0);
+    finished(edges, nd, w, &o, extent)
+}
+
+/// What both setups compute alike from the three (unscaled) vertices: the
+/// normal `N = (v1 − v0) × (v2 − v0)`, the determinant `N·v0` and its sign
+/// where its f32 error bound makes it certain.
+struct Orientation<L> {
+    normal: V<L>,
+    /// `|N·v0|`.
+    volume: L,
+    /// `+1` or `−1`.
+    sign: L,
+    positive: u8,
+    /// Lanes the lanes decide: unscaled vertices and a certain sign (the
+    /// others are the scalar setup's).
+    certain: u8,
+}
+
+impl<L: Lanes> Orientation<L> {
+    #[inline(always)]
+    fn of(v0: V<L>, v1: V<L>, v2: V<L>) -> Orientation<L> {
+        // Lanes that `scaled` would scale are left to the scalar setup.
+        let largest = (v0.abs().max_element())
+            .max(v1.abs().max_element())
+            .max(v2.abs().max_element());
+        let unscaled = largest.le(L::splat(SCALE_ABOVE));
+        let (e1, e2) = (v1.sub(v0), v2.sub(v0));
+        let normal = e1.cross(e2);
+        let d = normal.dot(v0);
+        let bound = L::splat(16.0 * EPS) * e1.abs_cross(e2).dot(v0.abs());
+        let positive = d.gt(bound);
+        let negative = d.lt(L::splat(0.0) - bound);
+        Orientation {
+            normal,
+            volume: abs(d),
+            sign: signs(positive),
+            positive,
+            certain: unscaled & (positive | negative),
+        }
+    }
+}
+
+/// The lane setups from the three edges with their coefficient errors, the
+/// depth's denominator `nd`, the vertices' `w` and the orientation: the
+/// tolerances, and the lanes decided where every value is finite (the
+/// scalar setup says `None` to the others).
+#[inline(always)]
+fn finished<L: Lanes>(
+    edges: [([L; 3], L); 3],
+    nd: [L; 3],
+    w: [L; 3],
+    o: &Orientation<L>,
+    extent: (f32, f32),
+) -> LaneSetups {
+    let [(edge0, r0), (edge1, r1), (edge2, r2)] = edges;
+    let tolerances = [
+        tolerance(edge0, r0, extent),
+        tolerance(edge1, r1, extent),
+        tolerance(edge2, r2, extent),
+    ];
+    let mut nan = o.volume * L::splat(0.0);
     for values in [edge0, edge1, edge2, nd, tolerances, w] {
         nan = add_nan_if_not_finite(nan, values);
     }
@@ -412,11 +425,11 @@ fn homogeneous_lanes_on<L: Lanes>(h: &Corners, w: &[[f32; 8]; 3], view: &View) -
     LaneSetups {
         edges: [arrays(edge0), arrays(edge1), arrays(edge2)],
         nd: arrays(nd),
-        volume: volume.to_array(),
+        volume: o.volume.to_array(),
         w: arrays(w),
         tolerance: arrays(tolerances),
-        negated: !positive,
-        decided: unscaled & (positive | negative) & finite,
+        negated: !o.positive,
+        decided: o.certain & finite,
     }
 }
 
@@ -571,16 +584,15 @@ mod tests {
                     present: if k % 3 == 0 { 0b1011_0110 } else { 0xff },
                 };
                 let lanes = homogeneous_eight_with(&t, &points, &view, kernel);
-                for l in 0..8 {
+                for (l, lane) in lanes.iter().enumerate() {
                     let vertices = t.vertices[l].map(|v| points[v as usize]);
                     let scalar = (t.present >> l & 1 == 1)
                         .then(|| setup_homogeneous_from(t.corners[l], vertices, &view))
                         .flatten();
                     assert!(
-                        same(&lanes[l], &scalar),
-                        "{:?}: lanes {:?}, scalar {scalar:?}",
+                        same(lane, &scalar),
+                        "{:?}: lanes {lane:?}, scalar {scalar:?}",
                         t.corners[l],
-                        lanes[l]
                     );
                     checked += 1;
                     set_up += usize::from(scalar.is_some());
