@@ -603,6 +603,16 @@ mod tests {
         assert!(set_up > 16_000, "{set_up} set up");
     }
 
+    /// The AVX2 tests check the AVX2 kernels: the dispatched kernel takes
+    /// them where the CPU has AVX2, and on x86-64 it must.
+    fn require_avx2() {
+        #[cfg(target_arch = "x86_64")]
+        assert!(
+            simd::cpu_has_avx2(),
+            "this test checks the AVX2 kernel, and this CPU has no AVX2"
+        );
+    }
+
     #[test]
     fn portable_homogeneous_lanes_set_up_as_the_scalar_setup() {
         homogeneous_lanes_set_up_as_the_scalar_setup(homogeneous_lanes_on::<simd::Portable>);
@@ -610,11 +620,7 @@ mod tests {
 
     #[test]
     fn avx2_homogeneous_lanes_set_up_as_the_scalar_setup() {
-        #[cfg(target_arch = "x86_64")]
-        assert!(
-            simd::cpu_has_avx2(),
-            "this test checks the AVX2 kernel, and this CPU has no AVX2"
-        );
+        require_avx2();
         homogeneous_lanes_set_up_as_the_scalar_setup(homogeneous_lanes);
     }
 
@@ -625,11 +631,7 @@ mod tests {
 
     #[test]
     fn avx2_lanes_set_up_as_the_scalar_setup() {
-        #[cfg(target_arch = "x86_64")]
-        assert!(
-            simd::cpu_has_avx2(),
-            "this test checks the AVX2 kernel, and this CPU has no AVX2"
-        );
+        require_avx2();
         // `perspective_lanes` takes AVX2 where the CPU has it.
         lanes_set_up_as_the_scalar_setup(perspective_lanes);
     }
