@@ -79,6 +79,11 @@ fn main() -> ExitCode {
         // nothing reads the environment while it changes.
         unsafe { std::env::set_var("XDG_RUNTIME_DIR", dir) };
     }
+    // Freed pages stay with the process for the next frame (see the
+    // server's `keep_freed_memory`): `mi_option_purge_delay` (15) = −1.
+    // SAFETY: `mi_option_set` stores an integer option (no pointers, any
+    // value is valid); called at the start of `main`, before any thread.
+    unsafe { libmimalloc_sys::mi_option_set(15, -1) };
     let args = Args::parse();
     if let Some(name) = &args.adapter {
         continuum::choose_gpu_adapter(name);
