@@ -194,10 +194,10 @@ impl SceneBvh {
     /// origin (every perspective and spherical view) are tested together by
     /// [`PacketInterval`], one 8-lane test per node for the whole packet;
     /// others ray by ray. `leaf(slot, cull)` is called for each primitive slot
-    /// of every leaf the packet reaches, updates each lane's culling
-    /// distance in `cull` and says whether it changed any. Returns the number of nodes whose children were
-    /// tested (once per node, for the packet), and adds their indices to
-    /// `entered` when given (a render's trace). The slab tests run on lanes `L`
+    /// of every leaf the packet reaches, updates each lane's culling distance
+    /// in `cull` and says whether it changed any. Returns the number of nodes
+    /// whose children were tested (once per node, for the packet), and adds
+    /// their indices to `entered` when given (a render's trace). The slab tests run on lanes `L`
     /// (the caller's instruction set, see [`crate::simd`]; inlined into it).
     #[inline(always)]
     pub fn walk_packet<L: Lanes>(
