@@ -73,6 +73,9 @@ struct Args {
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
+/// `mi_option_purge_delay` of mimalloc's `mi_option_t` (`mimalloc.h`).
+const MI_OPTION_PURGE_DELAY: libmimalloc_sys::mi_option_t = 15;
+
 fn main() -> ExitCode {
     if let Some(dir) = continuum::mesa::private_runtime_dir() {
         // SAFETY: the first statement of `main`, before any thread exists, so
@@ -80,10 +83,10 @@ fn main() -> ExitCode {
         unsafe { std::env::set_var("XDG_RUNTIME_DIR", dir) };
     }
     // Freed pages stay with the process for the next frame (see the
-    // server's `keep_freed_memory`): `mi_option_purge_delay` (15) = −1.
+    // server's `keep_freed_memory`).
     // SAFETY: `mi_option_set` stores an integer option (no pointers, any
     // value is valid); called at the start of `main`, before any thread.
-    unsafe { libmimalloc_sys::mi_option_set(15, -1) };
+    unsafe { libmimalloc_sys::mi_option_set(MI_OPTION_PURGE_DELAY, -1) };
     let args = Args::parse();
     if let Some(name) = &args.adapter {
         continuum::choose_gpu_adapter(name);
