@@ -167,7 +167,7 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                 let entered = trace_nodes.as_mut();
                 nodes += scene.bvh.walk_packet::<L>(packet, entered, |k, cull| {
                     // The box first: most leaf triangles miss a packet's block.
-                    let Some((rect, id)) = setups.boxes[k as usize] else {
+                    let Some((rect, id)) = setups.boxes[k as usize].get() else {
                         return false;
                     };
                     let inside = block_mask(rect, x, y);

@@ -71,8 +71,8 @@ fn setup_pieces<T: Send>(
     let corners = &scene.scene.mesh.triangles;
     let pieces = |id: u32| pieces_of(scene, view, span, &planes, &make, id);
     let item = |piece: Option<Piece<T>>| match piece {
-        Some(Piece { tri, rect, id }) => (Some((rect, id)), Some(tri)),
-        None => (None, None),
+        Some(Piece { tri, rect, id }) => (ItemBox::new(rect, id), Some(tri)),
+        None => (ItemBox::NONE, None),
     };
     let (first, more): (Columns<T>, Vec<bool>) = scene
         .drawable

@@ -110,10 +110,10 @@ fn paired<T>(
     ids: [&u32; 8],
     mut triangles: [Option<T>; 8],
 ) -> ([ItemBox; 8], [Option<T>; 8]) {
-    let mut boxes = [None; 8];
+    let mut boxes = [ItemBox::NONE; 8];
     for l in 0..8 {
         match rects[l] {
-            Some(rect) if triangles[l].is_some() => boxes[l] = Some((rect, *ids[l])),
+            Some(rect) if triangles[l].is_some() => boxes[l] = ItemBox::new(rect, *ids[l]),
             _ => triangles[l] = None,
         }
     }
