@@ -23,6 +23,7 @@ use crate::edge::EPS;
 use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
+use crate::simd::{self, Lanes};
 
 /// Non-planar viewports' screen box: the bounds of the triangle's cap of
 /// directions ([`crate::camera::SphereMap::bounds_of`]), padded by a pixel.
@@ -303,6 +304,58 @@ impl ScreenBoxes {
         map.image_box(p, &points, view)?.pixels(view, span)
     }
 
+    /// [`ScreenBoxes::rect`] of the first `n` of eight triangles, the same
+    /// boxes: where a triangle's three vertices are projected (the common
+    /// case), its box and pixels are computed eight triangles at a time
+    /// ([`pixels_eight`]); the others take [`ScreenBoxes::rect`]'s own path.
+    #[inline]
+    pub(crate) fn rects_eight(
+        &self,
+        corners: &[&[Vec3; 3]; 8],
+        vertices: &[[u32; 3]; 8],
+        n: usize,
+        view: &View,
+        span: SampleSpan,
+    ) -> [Option<PixelRect>; 8] {
+        let mut rects = [None; 8];
+        let Some(map) = &self.map else {
+            for (l, rect) in rects.iter_mut().enumerate().take(n) {
+                *rect = sphere_rect(corners[l], view, span);
+            }
+            return rects;
+        };
+        // 0 in lanes not computed here.
+        let mut points: LanePoints = [[[0.0; 8]; 3]; 3];
+        let mut projected = 0u8;
+        for l in 0..n.min(8) {
+            let vertex = vertices[l].map(|v| self.points[v as usize]);
+            let mut all = true;
+            for (k, point) in vertex.iter().enumerate() {
+                match *point {
+                    ImagePoint::Projected { x, y, pad } => {
+                        [points[0][k][l], points[1][k][l], points[2][k][l]] = [x, y, pad];
+                    }
+                    _ => all = false,
+                }
+            }
+            if all {
+                projected |= 1 << l;
+            } else {
+                rects[l] =
+                    (map.image_box(corners[l], &vertex, view)).and_then(|b| b.pixels(view, span));
+            }
+        }
+        if projected != 0 {
+            let computed = pixels_eight(&points, [view.width, view.height], span);
+            for (l, rect) in rects.iter_mut().enumerate() {
+                if projected >> l & 1 == 1 {
+                    *rect = computed[l];
+                }
+            }
+        }
+        rects
+    }
+
     /// The pixels with a sample in a conservative screen box of the
     /// axis-aligned box `lo..hi` ([`ImageMap::box_bounds`]): every pixel a
     /// triangle with its vertices inside may cover. `None` on non-planar views
@@ -320,6 +373,65 @@ impl ScreenBoxes {
             .box_bounds(lo, hi, view.eye)?
             .pixels(view, span)
     }
+}
+
+/// Eight triangles' projected vertices: x, y and rounding bound (as in
+/// [`ImagePoint::Projected`]), each per vertex and lane.
+type LanePoints = [[[f32; 8]; 3]; 3];
+
+simd::dispatch! {
+    /// [`ImageBox::of`] and [`ImageBox::pixels`] for eight triangles, one per
+    /// lane: `points` holds per coordinate (x, y, rounding bound) and vertex
+    /// each lane's projected vertex. The same operations as the scalar ones,
+    /// so the same pixels: minima, maxima and the bound's maximum are exact
+    /// in any order on the finite values [`ImageMap::point`] projects, and
+    /// the lanes' `floor`/`ceil` are exact (`PixelRect::from_bounds`'s
+    /// differ from them only in the sign of a zero, which the pixel bounds
+    /// do not see).
+    fn pixels_eight<>(
+        points: &LanePoints,
+        size: [u32; 2],
+        span: SampleSpan,
+    ) -> [Option<PixelRect>; 8] => pixels_eight_on
+}
+
+#[inline(always)]
+fn pixels_eight_on<L: Lanes>(
+    [xs, ys, pads]: &LanePoints,
+    [width, height]: [u32; 2],
+    span: SampleSpan,
+) -> [Option<PixelRect>; 8] {
+    let (mut min_x, mut min_y) = (L::from_array(xs[0]), L::from_array(ys[0]));
+    let (mut max_x, mut max_y) = (min_x, min_y);
+    let mut pad = L::splat(0.0).max(L::from_array(pads[0]));
+    for k in 1..3 {
+        let (x, y) = (L::from_array(xs[k]), L::from_array(ys[k]));
+        (min_x, min_y) = (min_x.min(x), min_y.min(y));
+        (max_x, max_y) = (max_x.max(x), max_y.max(y));
+        pad = pad.max(L::from_array(pads[k]));
+    }
+    // `PixelRect::from_bounds` of the padded box.
+    let zero = L::splat(0.0);
+    let x0 = ((min_x - pad) - L::splat(span.hi[0])).ceil().max(zero);
+    let y0 = ((min_y - pad) - L::splat(span.hi[1])).ceil().max(zero);
+    let x1 = ((max_x + pad) - L::splat(span.lo[0])).floor();
+    let y1 = ((max_y + pad) - L::splat(span.lo[1])).floor();
+    let x1 = x1.min(L::splat(width as f32 - 1.0));
+    let y1 = y1.min(L::splat(height as f32 - 1.0));
+    let some = x0.le(x1) & y0.le(y1);
+    let [x0, y0, x1, y1] = [x0, y0, x1, y1].map(L::to_array);
+    let mut rects = [None; 8];
+    for (l, rect) in rects.iter_mut().enumerate() {
+        if some >> l & 1 == 1 {
+            *rect = Some(PixelRect {
+                x0: x0[l] as u32,
+                y0: y0[l] as u32,
+                x1: x1[l] as u32 + 1,
+                y1: y1[l] as u32 + 1,
+            });
+        }
+    }
+    rects
 }
 
 /// A box of image points, padded.
@@ -605,5 +717,141 @@ mod tests {
                 "({px}, {py}) for ({x}, {y})"
             );
         }
+    }
+
+    /// An image point for the lane tests: on and around pixel borders and
+    /// sample offsets, off the image, and far beyond f32's integers.
+    fn coordinate(rng: &mut fastrand::Rng, n: u32) -> f32 {
+        let n = n as f32;
+        match rng.u32(0..6) {
+            0 => rng.i32(-3..n as i32 + 3) as f32,
+            1 => rng.i32(-3..n as i32 + 3) as f32 + 0.5,
+            2 => (rng.i32(-3..n as i32 + 3) as f32 + 0.5).next_up(),
+            3 => (rng.f32() - 0.5) * [1e4, 1e8, 3e38][rng.usize(0..3)],
+            _ => (rng.f32() * 1.2 - 0.1) * n,
+        }
+    }
+
+    /// `pixels` (one of the lane forms of [`pixels_eight`]) gives, lane by
+    /// lane, the pixels [`ImageBox::of`] and [`ImageBox::pixels`] give each
+    /// lane's three points, for every sample span and image size, with
+    /// bounds that round, clamp, overflow to infinity or leave the image.
+    fn eight_boxes_are_the_single_ones(
+        pixels: fn(&LanePoints, [u32; 2], SampleSpan) -> [Option<PixelRect>; 8],
+    ) {
+        let mut rng = fastrand::Rng::with_seed(21);
+        let aa = [
+            AaMode::None,
+            AaMode::Ssaa(16),
+            AaMode::Csaa {
+                coverage: 8,
+                stored: 4,
+            },
+        ];
+        let (mut checked, mut some) = (0, 0);
+        for _ in 0..4_000 {
+            let size = (rng.u32(1..3000), rng.u32(1..3000));
+            let view = view(
+                Vec3::Z,
+                Vec3::ZERO,
+                Viewport::Perspective { fov_y_deg: 60.0 },
+                size,
+                0.1,
+            );
+            let span = SamplePattern::of(aa[rng.usize(0..3)]).span;
+            let mut points: LanePoints = [[[0.0; 8]; 3]; 3];
+            let [xs, ys, pads] = &mut points;
+            for k in 0..3 {
+                for l in 0..8 {
+                    xs[k][l] = coordinate(&mut rng, size.0);
+                    ys[k][l] = coordinate(&mut rng, size.1);
+                    pads[k][l] = [2f32.powi(-20), 1e-3, 0.3, 1e38][rng.usize(0..4)];
+                }
+            }
+            let lanes = pixels(&points, [size.0, size.1], span);
+            for (l, lane) in lanes.into_iter().enumerate() {
+                let vertex = std::array::from_fn(|k| ImagePoint::Projected {
+                    x: points[0][k][l],
+                    y: points[1][k][l],
+                    pad: points[2][k][l],
+                });
+                let single = ImageBox::of(&vertex).and_then(|b| b.pixels(&view, span));
+                assert_eq!(lane, single, "lane {l} of {points:?} on {size:?}");
+                (checked, some) = (checked + 1, some + usize::from(single.is_some()));
+            }
+        }
+        assert_eq!(checked, 32_000);
+        assert!(some > 8_000, "{some} boxes with pixels");
+    }
+
+    #[test]
+    fn portable_eight_boxes_are_the_single_ones() {
+        eight_boxes_are_the_single_ones(pixels_eight_on::<simd::Portable>);
+    }
+
+    #[test]
+    fn avx2_eight_boxes_are_the_single_ones() {
+        #[cfg(target_arch = "x86_64")]
+        assert!(
+            simd::cpu_has_avx2(),
+            "this test checks the AVX2 kernel, and this CPU has no AVX2"
+        );
+        // `pixels_eight` takes AVX2 where the CPU has it.
+        eight_boxes_are_the_single_ones(pixels_eight);
+    }
+
+    /// [`ScreenBoxes::rects_eight`] is [`ScreenBoxes::rect`] per triangle, on
+    /// every viewport, for groups of one to eight triangles that reach
+    /// nearer than `near` (the clipped path), behind the eye or not at all.
+    #[test]
+    fn rects_of_eight_triangles_are_their_rects() {
+        let mut rng = fastrand::Rng::with_seed(23);
+        let (mut checked, mut some) = (0, 0);
+        for case in 0..400 {
+            let eye = Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 4.0;
+            let viewport = [
+                Viewport::Perspective { fov_y_deg: 60.0 },
+                Viewport::Orthographic { height: 3.0 },
+                Viewport::Parabolic,
+                Viewport::LatLong,
+            ][case % 4];
+            let view = view(
+                eye,
+                eye - Vec3::Z,
+                viewport,
+                (rng.u32(1..400), rng.u32(1..400)),
+                0.1,
+            );
+            let positions: Vec<Vec3> = (0..24)
+                .map(|_| {
+                    eye + Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, -rng.f32() * 1.2 + 0.1) * 3.0
+                })
+                .collect();
+            let screen = ScreenBoxes::of(&positions, &view);
+            let triangles: Vec<[Vec3; 3]> = positions
+                .chunks_exact(3)
+                .map(|t| [t[0], t[1], t[2]])
+                .collect();
+            let n = rng.usize(1..=8);
+            let corners = std::array::from_fn(|l| &triangles[l.min(n - 1)]);
+            let vertices = std::array::from_fn(|l| {
+                let k = 3 * l.min(n - 1) as u32;
+                [k, k + 1, k + 2]
+            });
+            let span = SamplePattern::of(AaMode::None).span;
+            let rects = screen.rects_eight(&corners, &vertices, n, &view, span);
+            for l in 0..8 {
+                let single = (l < n)
+                    .then(|| screen.rect(corners[l], vertices[l], &view, span))
+                    .flatten();
+                assert_eq!(rects[l], single, "case {case}, lane {l} of {n}");
+                checked += usize::from(l < n);
+                some += usize::from(single.is_some());
+            }
+        }
+        assert!(
+            checked > 1_000 && some > 500,
+            "{checked} checked, {some} with pixels"
+        );
     }
 }

@@ -52,6 +52,10 @@ mod sealed {
         fn min(self, o: Self) -> Self;
         /// The correctly rounded square root (IEEE, as `f32::sqrt`).
         fn sqrt(self) -> Self;
+        /// The largest integer not above each lane (exact, as `f32::floor`).
+        fn floor(self) -> Self;
+        /// The smallest integer not below each lane (exact, as `f32::ceil`).
+        fn ceil(self) -> Self;
         fn gt(self, o: Self) -> u8;
         fn lt(self, o: Self) -> u8;
         fn ge(self, o: Self) -> u8;
@@ -84,6 +88,14 @@ impl sealed::Ops for Portable {
     #[inline(always)]
     fn sqrt(self) -> Self {
         wide::f32x8::sqrt(self)
+    }
+    #[inline(always)]
+    fn floor(self) -> Self {
+        wide::f32x8::floor(self)
+    }
+    #[inline(always)]
+    fn ceil(self) -> Self {
+        wide::f32x8::ceil(self)
     }
     #[inline(always)]
     fn gt(self, o: Self) -> u8 {
@@ -190,6 +202,14 @@ mod avx2_lanes {
         #[inline(always)]
         fn sqrt(self) -> Self {
             Avx2(avx!(_mm256_sqrt_ps(self.0)))
+        }
+        #[inline(always)]
+        fn floor(self) -> Self {
+            Avx2(avx!(_mm256_floor_ps(self.0)))
+        }
+        #[inline(always)]
+        fn ceil(self) -> Self {
+            Avx2(avx!(_mm256_ceil_ps(self.0)))
         }
         #[inline(always)]
         fn gt(self, o: Self) -> u8 {

@@ -91,12 +91,12 @@ pub(crate) fn setup_slots<'a, T: Send>(
         .zip(scene.slot_vertices.par_chunks(8))
         .zip(scene.slot_triangles.par_chunks(8));
     let eights = chunks.map(|((p, vertices), ids)| {
-        let (rects, present) = rects_of(p.len(), |l| boxes.rect(&p[l], vertices[l], view, span));
-        let eight = EightTriangles {
+        let mut eight = EightTriangles {
             corners: lanes_of(p),
             vertices: lanes_of(vertices).map(|v| *v),
-            present,
+            present: 0,
         };
+        let rects = rects_of(&boxes, &mut eight, p.len(), view, span);
         paired(rects, lanes_of(ids), setup(&eight, view))
     });
     flattened(eights.unzip(), scene.slot_triangles.len())
@@ -137,16 +137,22 @@ fn lanes_of<T>(v: &[T]) -> [&T; 8] {
     std::array::from_fn(|l| &v[l.min(v.len() - 1)])
 }
 
-/// The screen boxes `rect(l)` of the first `n` lanes, and the mask of the
-/// lanes that have one (the lanes to set up).
+/// The screen boxes of the first `n` of `eight`'s triangles, whose
+/// `present` mask becomes the lanes that have one (the lanes to set up).
 #[inline]
-fn rects_of(n: usize, rect: impl Fn(usize) -> Option<PixelRect>) -> ([Option<PixelRect>; 8], u8) {
-    let (mut rects, mut present) = ([None; 8], 0u8);
-    for (l, slot) in rects.iter_mut().enumerate().take(n) {
-        *slot = rect(l);
-        present |= u8::from(slot.is_some()) << l;
+fn rects_of(
+    boxes: &ScreenBoxes,
+    eight: &mut EightTriangles,
+    n: usize,
+    view: &View,
+    span: SampleSpan,
+) -> [Option<PixelRect>; 8] {
+    let rects = boxes.rects_eight(&eight.corners, &eight.vertices, n, view, span);
+    eight.present = 0;
+    for (l, rect) in rects.iter().enumerate() {
+        eight.present |= u8::from(rect.is_some()) << l;
     }
-    (rects, present)
+    rects
 }
 
 /// Every drawable triangle set up by `setup` with its conservative screen
@@ -176,10 +182,7 @@ fn setup_visible<'a, T: Send>(
             vertices: id.map(|id| corners[id]),
             present: 0,
         };
-        let (rects, present) = rects_of(ids.len(), |l| {
-            boxes.rect(eight.corners[l], eight.vertices[l], view, span)
-        });
-        eight.present = present;
+        let rects = rects_of(&boxes, &mut eight, ids.len(), view, span);
         paired(rects, lanes_of(ids), setup(&eight, view))
     });
     flattened(eights.unzip(), scene.drawable.len())
