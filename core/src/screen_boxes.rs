@@ -512,6 +512,16 @@ mod tests {
     use crate::edge::{Coverage, Triangle3D64};
     use crate::viewport::Viewport;
 
+    /// One mode of each anti-aliasing family: sample spans of each kind.
+    const AA_FAMILIES: [AaMode; 3] = [
+        AaMode::None,
+        AaMode::Ssaa(16),
+        AaMode::Csaa {
+            coverage: 8,
+            stored: 4,
+        },
+    ];
+
     fn view(eye: Vec3, target: Vec3, viewport: Viewport, size: (u32, u32), near: f32) -> View {
         let camera = Camera {
             name: "test".into(),
@@ -570,15 +580,7 @@ mod tests {
             };
             let near = [1e-3, 0.1, 1.0][rng.usize(0..3)];
             let view = view(eye, target, viewport, size, near);
-            let aa = [
-                AaMode::None,
-                AaMode::Ssaa(16),
-                AaMode::Csaa {
-                    coverage: 8,
-                    stored: 4,
-                },
-            ];
-            let pattern = SamplePattern::of(aa[rng.usize(0..3)]);
+            let pattern = SamplePattern::of(AA_FAMILIES[rng.usize(0..3)]);
             // Triangles: one vertex on a sample's ray, the others a few pixels
             // (or a fraction of one) away, at depths around and across `near`.
             let mut positions = Vec::new();
@@ -740,14 +742,6 @@ mod tests {
         pixels: fn(&LanePoints, [u32; 2], SampleSpan) -> [Option<PixelRect>; 8],
     ) {
         let mut rng = fastrand::Rng::with_seed(21);
-        let aa = [
-            AaMode::None,
-            AaMode::Ssaa(16),
-            AaMode::Csaa {
-                coverage: 8,
-                stored: 4,
-            },
-        ];
         let (mut checked, mut some) = (0, 0);
         for _ in 0..4_000 {
             let size = (rng.u32(1..3000), rng.u32(1..3000));
@@ -758,7 +752,7 @@ mod tests {
                 size,
                 0.1,
             );
-            let span = SamplePattern::of(aa[rng.usize(0..3)]).span;
+            let span = SamplePattern::of(AA_FAMILIES[rng.usize(0..3)]).span;
             let mut points: LanePoints = [[[0.0; 8]; 3]; 3];
             let [xs, ys, pads] = &mut points;
             for k in 0..3 {
