@@ -152,12 +152,28 @@ impl Shader<'_> {
         let mut vertex_normals = [[Vec3::ZERO; 8]; 3];
         let mut base = [Vec3::ZERO; 8];
         let mut emissive = [Vec3::ZERO; 8];
+        // The lane that last gathered, its triangle, and whether one of
+        // that triangle's vertex normals is zero (the scalar path's case).
+        let mut previous: Option<(usize, usize, bool)> = None;
         for l in 0..8 {
             let id = if done & (1 << l) != 0 {
                 s.ids[l]
             } else {
                 first
             } as usize;
+            // Neighbouring samples mostly hold one triangle: its records are
+            // the previous lane's (no second gather of the same ones).
+            if let Some((_, last, zero_normal)) = previous.filter(|p| p.0 == id) {
+                for k in 0..3 {
+                    corners[k][l] = corners[k][last];
+                    vertex_normals[k][l] = vertex_normals[k][last];
+                }
+                (base[l], emissive[l]) = (base[last], emissive[last]);
+                if zero_normal {
+                    done &= !(1 << l);
+                }
+                continue;
+            }
             let (p, vertices) = prepared.corners_and_vertices(id as u32);
             for k in 0..3 {
                 corners[k][l] = p[k];
@@ -165,14 +181,17 @@ impl Shader<'_> {
             let material = &prepared.scene.materials[self.material_of(id as u32) as usize];
             base[l] = Vec3::from_slice(&material.base_color[..3]);
             emissive[l] = Vec3::from(material.emissive);
+            let mut zero_normal = false;
             if interpolated {
                 for (k, &v) in vertices.iter().enumerate() {
                     vertex_normals[k][l] = mesh.normals[v as usize];
                 }
-                if (0..3).any(|k| vertex_normals[k][l] == Vec3::ZERO) {
+                zero_normal = (0..3).any(|k| vertex_normals[k][l] == Vec3::ZERO);
+                if zero_normal {
                     done &= !(1 << l);
                 }
             }
+            previous = Some((id, l, zero_normal));
         }
         let (p0, p1, p2) = (
             V3::<L>::of(&corners[0]),
