@@ -1,6 +1,7 @@
 //! Screen tiles: triangles are sorted into tiles of the image (rows of 256
-//! pixels, 16 deep) by their bounding boxes (a counting sort), and the tiles are rendered in parallel,
-//! each into its own [`TileBuffer`](crate::framebuffer::TileBuffer) and resolved there.
+//! pixels, 16 deep) by their bounding boxes (a counting sort), and the tiles
+//! are rendered in parallel, each into its own
+//! [`TileBuffer`](crate::framebuffer::TileBuffer) and resolved there.
 
 use rayon::prelude::*;
 
