@@ -318,21 +318,15 @@ impl ScreenBoxes {
         span: SampleSpan,
     ) -> [Option<PixelRect>; 8] {
         let mut rects = [None; 8];
-        let Some(map) = &self.map else {
-            for (l, rect) in rects.iter_mut().enumerate().take(n) {
-                *rect = sphere_rect(corners[l], view, span);
-            }
-            return rects;
-        };
         // 0 in lanes not computed here.
         let mut points: LanePoints = [[[0.0; 8]; 3]; 3];
         let mut projected = 0u8;
         for l in 0..n.min(8) {
-            let vertex = vertices[l].map(|v| self.points[v as usize]);
-            let mut all = true;
-            for (k, point) in vertex.iter().enumerate() {
-                match *point {
-                    ImagePoint::Projected { x, y, pad } => {
+            // Non-planar views project nothing (`points` is empty).
+            let mut all = self.map.is_some();
+            for (k, &v) in vertices[l].iter().enumerate() {
+                match self.points.get(v as usize) {
+                    Some(&ImagePoint::Projected { x, y, pad }) => {
                         [points[0][k][l], points[1][k][l], points[2][k][l]] = [x, y, pad];
                     }
                     _ => all = false,
@@ -341,8 +335,7 @@ impl ScreenBoxes {
             if all {
                 projected |= 1 << l;
             } else {
-                rects[l] =
-                    (map.image_box(corners[l], &vertex, view)).and_then(|b| b.pixels(view, span));
+                rects[l] = self.rect(corners[l], vertices[l], view, span);
             }
         }
         if projected != 0 {
