@@ -7,7 +7,7 @@
 
 use std::hint::black_box;
 
-use continuum::internal::{Isa, Triangle3D, covered_samples};
+use continuum::internal::{Isa, Shared3D, Triangle3D, covered_samples};
 use continuum::{Camera, View, Viewport};
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
@@ -39,24 +39,26 @@ fn coverage(c: &mut Criterion) {
             [corner(), corner(), corner()]
         })
         .collect();
-    let triangles: Vec<Triangle3D> = vertices
+    let set_up: Vec<Option<Triangle3D>> = vertices
         .iter()
-        .filter_map(|p| Triangle3D::setup(p, &view))
+        .map(|p| Triangle3D::setup(p, &view))
         .collect();
+    let shared = Shared3D::of_corners(&view, false, &vertices);
+    let triangles = (set_up.as_slice(), &shared);
 
     let mut group = c.benchmark_group("coverage/sample_run");
-    let portable = covered_samples(&triangles, WIDTH, HEIGHT, Isa::Portable);
+    let portable = covered_samples(triangles, WIDTH, HEIGHT, Isa::Portable);
     group.bench_function("portable", |b| {
-        b.iter(|| covered_samples(black_box(&triangles), WIDTH, HEIGHT, Isa::Portable));
+        b.iter(|| covered_samples(black_box(triangles), WIDTH, HEIGHT, Isa::Portable));
     });
-    if let Some(avx2) = covered_samples(&triangles, WIDTH, HEIGHT, Isa::Avx2) {
+    if let Some(avx2) = covered_samples(triangles, WIDTH, HEIGHT, Isa::Avx2) {
         assert_eq!(
             portable,
             Some(avx2),
             "the two instruction sets cover different samples"
         );
         group.bench_function("avx2", |b| {
-            b.iter(|| covered_samples(black_box(&triangles), WIDTH, HEIGHT, Isa::Avx2));
+            b.iter(|| covered_samples(black_box(triangles), WIDTH, HEIGHT, Isa::Avx2));
         });
     }
     group.finish();

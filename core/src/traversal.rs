@@ -18,7 +18,7 @@ use obvhs::cwbvh::node::CwBvhNode;
 use crate::binning::raster_triangle;
 use crate::bvh::{Children, SlabRay, padded};
 use crate::camera::View;
-use crate::edge::Coverage;
+use crate::edge::Stored;
 use crate::framebuffer::TileBuffer;
 use crate::ground::PixelRect;
 use crate::pipeline::TraversalOracles;
@@ -76,12 +76,14 @@ impl<T: Copy> Default for LeafCache<T> {
 }
 
 /// Per-frustum traversal state and counters.
-pub(crate) struct Traversal<'a, 't, T> {
+pub(crate) struct Traversal<'a, 't, T: Stored> {
     pub scene: &'a PreparedScene,
     pub view: &'a View,
     pub oracles: TraversalOracles,
     pub tile: &'t mut TileBuffer<'a>,
     pub setup: Setup<'a, T>,
+    /// What the view's set-up triangles share.
+    pub shared: &'t T::Shared<'a>,
     /// The leaf triangles' screen boxes.
     pub boxes: &'t ScreenBoxes,
     /// The leaf triangles this work item set up last.
@@ -217,7 +219,7 @@ impl Frustum {
     }
 }
 
-impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
+impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
     /// A traversal of the frustum over `tile`'s pixels, leaf triangles set up
     /// by `setup` over their `boxes`, once each in `leaves` (emptied first).
     pub fn new(
@@ -225,7 +227,7 @@ impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
         view: &'a View,
         oracles: TraversalOracles,
         tile: &'t mut TileBuffer<'a>,
-        (setup, boxes): (Setup<'a, T>, &'t ScreenBoxes),
+        (setup, shared, boxes): (Setup<'a, T>, &'t T::Shared<'a>, &'t ScreenBoxes),
         leaves: &'t mut LeafCache<T>,
     ) -> Self {
         leaves.leaves.fill(Leaf::EMPTY);
@@ -235,6 +237,7 @@ impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
             oracles,
             tile,
             setup,
+            shared,
             boxes,
             leaves,
             counters: RasterCounters::default(),
@@ -438,6 +441,7 @@ impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
         self.tile
             .record(|t| t.frusta.push((f, FrustumEvent::Rasterized)));
         let (view, boxes, span) = (self.view, self.boxes, self.tile.pattern.span);
+        let shared = self.shared;
         for slot in start..start + count {
             // The slot-ordered copies: a leaf's triangles sit side by side.
             let p = &scene.slot_corners[slot as usize];
@@ -452,7 +456,7 @@ impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
             let Some(clip) = leaf.rect.and_then(|rect| rect.intersect(f)) else {
                 continue;
             };
-            // By reference: a setup is larger than a cache line.
+            // By reference: a setup is a cache line or more.
             let tri = match &mut leaf.tri {
                 Some(tri) => {
                     self.counters.leaf_setups_reused += 1;
@@ -469,7 +473,7 @@ impl<'a, 't, T: Coverage + Copy> Traversal<'a, 't, T> {
             let id = scene.slot_triangles[slot as usize];
             raster_triangle(
                 self.tile,
-                tri,
+                &tri.bind(shared, id),
                 id,
                 clip,
                 self.oracles.samples,

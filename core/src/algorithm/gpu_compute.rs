@@ -28,7 +28,7 @@ use rayon::prelude::*;
 use super::{Pass, TileContext, setup2d};
 use crate::aa::SamplePattern;
 use crate::camera::View;
-use crate::edge::{Coverage, HomogeneousVertex, Triangle3D, setup_homogeneous_from};
+use crate::edge::{Coverage, HomogeneousVertex, Shared3D, Triangle3D, setup_homogeneous_from};
 use crate::framebuffer::{Framebuffer, TileBuffer, wins_depth_test};
 use crate::gpu::{ComputeSamples, TriWords, atomics, gpu};
 use crate::ground::{FieldError, PixelRect, SampleSpan};
@@ -152,14 +152,10 @@ fn record<'f>(
 
 /// The CPU's 3D or homogeneous setup of triangle `p` (`None`: no triangle,
 /// e.g. an exactly zero determinant).
-fn set_up_on_cpu<'a>(
-    kind: ComputeKind,
-    p: &'a [glam::Vec3; 3],
-    view: &'a View,
-) -> Option<Triangle3D<'a>> {
+fn set_up_on_cpu(kind: ComputeKind, p: &[glam::Vec3; 3], view: &View) -> Option<Triangle3D> {
     match kind {
         ComputeKind::Homogeneous => {
-            setup_homogeneous_from(p, p.map(|v| HomogeneousVertex::of(v, view)), view)
+            setup_homogeneous_from(p.map(|v| HomogeneousVertex::of(v, view)), view)
         }
         _ => Triangle3D::setup(p, view),
     }
@@ -184,7 +180,7 @@ fn set_up_exactly(
             let t = set_up_on_cpu(kind, p, view)?;
             let k = 3 * k as u32;
             let rect = boxes.rect(p, [k, k + 1, k + 2], view, span)?;
-            let (rows, flags) = t.gpu_rows();
+            let (rows, flags) = t.gpu_rows(view.is_orthographic());
             Some(record(rows.iter().flatten(), id, rect, flags))
         })
         .collect()
@@ -207,10 +203,13 @@ fn decide_unsure(
     let pixels = view.width as usize * view.height as usize;
     for group in unsure.chunk_by(|a, b| a[0] == b[0]) {
         let id = group[0][0];
-        let p = scene.triangle(id);
-        let Some(t) = set_up_on_cpu(kind, &p, view) else {
+        let p = [scene.triangle(id)];
+        let Some(t) = set_up_on_cpu(kind, &p[0], view) else {
             continue;
         };
+        let homogeneous = kind == ComputeKind::Homogeneous;
+        let shared = Shared3D::of_corners(view, homogeneous, &p);
+        let t = t.bind(&shared, 0);
         for &[_, i] in group {
             let i = i as usize;
             let pixel = i % pixels;

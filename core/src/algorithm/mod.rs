@@ -30,7 +30,7 @@ use rayon::prelude::*;
 use crate::aa::SamplePattern;
 use crate::binning::raster_triangle;
 use crate::camera::View;
-use crate::edge::{CurvedTriangle, Triangle3D, Triangle3D64};
+use crate::edge::{CurvedTriangle, Stored, Triangle3D, Triangle3D64};
 use crate::framebuffer::{Framebuffer, TileBuffer, TilePlanes, TileTotals};
 use crate::ground::{FieldError, PixelRect};
 use crate::pipeline::{EdgeKind, Pipeline, TraversalOracles};
@@ -79,7 +79,14 @@ pub(crate) fn run(
                     )
                 };
                 ($items:expr, spans) => {
-                    timed_tiles(&$items, fb, context, stats, start, raster_spans)
+                    timed_tiles(
+                        &$items,
+                        fb,
+                        context,
+                        stats,
+                        start,
+                        |tile, tri, id, clip, n| raster_spans(tile, tri, id, clip, n),
+                    )
                 };
             }
             let fixed = precision == Precision::Fixed;
@@ -109,16 +116,26 @@ pub(crate) fn run(
             }
         }
         Pipeline::Frusta(oracles) if f64 => {
-            render_frusta(scene, context, oracles, fb, stats, Triangle3D64::setup)
+            render_frusta(scene, context, oracles, fb, stats, &(), Triangle3D64::setup)
         }
         Pipeline::Frusta(oracles) => {
-            render_frusta(scene, context, oracles, fb, stats, Triangle3D::setup)
+            let shared = setup3d::shared_3d(scene, view, false);
+            render_frusta(
+                scene,
+                context,
+                oracles,
+                fb,
+                stats,
+                &shared,
+                Triangle3D::setup,
+            )
         }
         Pipeline::Rays if view.sphere.is_some() => raycast::render_raycast(
             scene,
             context,
             fb,
             stats,
+            (),
             setup3d::one_by_one(CurvedTriangle::setup),
         ),
         Pipeline::Rays if f64 => raycast::render_raycast(
@@ -126,11 +143,17 @@ pub(crate) fn run(
             context,
             fb,
             stats,
+            (),
             setup3d::one_by_one(Triangle3D64::setup),
         ),
-        Pipeline::Rays => {
-            raycast::render_raycast(scene, context, fb, stats, Triangle3D::setup_eight)
-        }
+        Pipeline::Rays => raycast::render_raycast(
+            scene,
+            context,
+            fb,
+            stats,
+            setup3d::shared_3d(scene, view, false),
+            Triangle3D::setup_eight,
+        ),
         Pipeline::Gpu => render_gpu(scene, context, fb, stats)?,
         Pipeline::Compute(kind) => compute(scene, kind, context, fb, stats)?,
     };
@@ -208,12 +231,13 @@ fn compute(
 
 /// The Fig. 7 traversal, one initial frustum per parallel work item, leaf
 /// triangles set up by `setup`.
-fn render_frusta<'a, T: crate::edge::Coverage + Copy>(
+fn render_frusta<'a, T: Stored + Copy>(
     scene: &'a PreparedScene,
     context: &TileContext<'a>,
     oracles: TraversalOracles,
     fb: &mut Framebuffer,
     stats: &mut Stats,
+    shared: &T::Shared<'a>,
     setup: Setup<'a, T>,
 ) -> Pass {
     let start = Instant::now();
@@ -228,7 +252,7 @@ fn render_frusta<'a, T: crate::edge::Coverage + Copy>(
             || (None, LeafCache::default()),
             |(cache, leaves), planes| {
                 context.run_tile(cache, planes, |tile| {
-                    let how = (setup, boxes);
+                    let how = (setup, shared, boxes);
                     let mut t = Traversal::new(scene, context.view, oracles, tile, how, leaves);
                     t.run();
                     (t.counters, t.nodes_visited, t.setups)
@@ -248,13 +272,13 @@ fn render_frusta<'a, T: crate::edge::Coverage + Copy>(
     pass
 }
 
-fn timed_tiles<T: Sync>(
+fn timed_tiles<T: Stored>(
     items: &tiles::Setups<T>,
     fb: &mut Framebuffer,
     context: &TileContext,
     stats: &mut Stats,
     start: Instant,
-    kernel: impl Fn(&mut TileBuffer, &T, u32, PixelRect, &mut RasterCounters) + Sync,
+    kernel: impl Fn(&mut TileBuffer, &T::Bound<'_>, u32, PixelRect, &mut RasterCounters) + Sync,
 ) -> Pass {
     stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
     let start = Instant::now();

@@ -1,8 +1,8 @@
 //! `raycast`: the ray-casting end of the continuum. One ray per sample walks the
 //! CWBVH front to back; each leaf triangle is tested with the *same* 3D edge
-//! function coefficients and the same [`Triangle3D::sample`] as `3dr-brute`, so
-//! the two agree bit for bit (obvhs's own triangle test is not watertight and is
-//! not used).
+//! function coefficients ([`Triangle3D`](crate::edge::Triangle3D)) and the
+//! same `Coverage::sample` as `3dr-brute`, so the two agree bit for bit
+//! (obvhs's own triangle test is not watertight and is not used).
 
 use std::time::Instant;
 
@@ -14,7 +14,7 @@ use super::{Pass, PixelRect, TileContext};
 use crate::aa::SamplePattern;
 use crate::bvh::{PACKET, PacketRays};
 use crate::camera::View;
-use crate::edge::Coverage;
+use crate::edge::{Coverage, Stored};
 use crate::framebuffer::{BACKGROUND, Fragment, Framebuffer, TileBuffer, wins_depth_test};
 use crate::prepared::PreparedScene;
 use crate::prepared::is_see_through;
@@ -41,11 +41,12 @@ const HALVES: usize = PACKET.div_ceil(8);
 /// rasterizers of this viewport use. Under CSAA the coverage-only positions are
 /// decided as the rasterizers decide them: each triangle a stored ray found is
 /// tested at every coverage position of the pixel.
-pub(crate) fn render_raycast<'a, T: Coverage + Send + Sync>(
+pub(crate) fn render_raycast<'a, T: Stored>(
     scene: &'a PreparedScene,
     context: &TileContext<'a>,
     fb: &mut Framebuffer,
     stats: &mut Stats,
+    shared: T::Shared<'a>,
     setup: impl SetupEight<'a, T>,
 ) -> Pass {
     let view = context.view;
@@ -53,7 +54,7 @@ pub(crate) fn render_raycast<'a, T: Coverage + Send + Sync>(
     // screen, in BVH slot order, with the conservative screen box the
     // rasterizers bound their search with: a ray tests a triangle only inside it.
     let start = Instant::now();
-    let setups = setup3d::setup_slots(scene, view, context.pattern.span, setup);
+    let setups = setup3d::setup_slots(scene, view, context.pattern.span, shared, setup);
     stats.triangle_setups = setups.placed();
     stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
 
@@ -83,7 +84,7 @@ pub(crate) fn render_raycast<'a, T: Coverage + Send + Sync>(
 
 simd::dispatch! {
     /// [`cast_band_on`] on the lanes of this CPU.
-    fn cast_band<T: Coverage>(
+    fn cast_band<T: Stored>(
         scene: &PreparedScene,
         view: &View,
         setups: &Setups<T>,
@@ -98,7 +99,7 @@ simd::dispatch! {
 /// each finds exactly the hit its single walk would. Returns the BVH nodes
 /// visited.
 #[inline(always)]
-fn cast_band_on<L: Lanes, T: Coverage>(
+fn cast_band_on<L: Lanes, T: Stored>(
     scene: &PreparedScene,
     view: &View,
     setups: &Setups<T>,
@@ -177,6 +178,7 @@ fn cast_band_on<L: Lanes, T: Coverage>(
                     let Some(tri) = &setups.triangles[k as usize] else {
                         return false;
                     };
+                    let tri = tri.bind(&setups.shared, id);
                     let see_through = is_see_through(opacity, id);
                     let mut moved = false;
                     for half in 0..HALVES {
@@ -270,7 +272,7 @@ fn directions_lanes<L: Lanes>(
 /// found (`slots[s]`: the BVH slot of stored sample `s`'s triangle), computed
 /// once per triangle.
 #[inline(always)]
-fn stored_masks<L: Lanes, T: Coverage>(
+fn stored_masks<L: Lanes, T: Stored>(
     setups: &Setups<T>,
     slots: &[u32; 8],
     tile: &mut TileBuffer,
@@ -291,7 +293,7 @@ fn stored_masks<L: Lanes, T: Coverage>(
                     continue;
                 };
                 tile.edge_evals[i] += pattern.coverage() as u32;
-                coverage_mask::<L, T>(tri, pattern, x, y)
+                coverage_mask::<L, _>(&tri.bind(&setups.shared, id), pattern, x, y)
             }
         };
         tile.masks[s * pixels + i] = mask;
@@ -331,7 +333,7 @@ fn coverage_mask<L: Lanes, T: Coverage>(tri: &T, pattern: &SamplePattern, x: u32
 /// positions the resolve reads it). One any-hit ray per such position; returns
 /// the BVH nodes visited.
 #[inline(always)]
-fn lost_coverage<L: Lanes, T: Coverage>(
+fn lost_coverage<L: Lanes, T: Stored>(
     scene: &PreparedScene,
     view: &View,
     setups: &Setups<T>,
@@ -358,8 +360,8 @@ fn lost_coverage<L: Lanes, T: Coverage>(
         };
         nodes += scene
             .bvh
-            .walk(origin, direction, |k| match &setups.triangles[k as usize] {
-                Some(tri) if tri.covers8::<L>([xs; 8], [ys; 8]) & 1 == 1 => {
+            .walk(origin, direction, |k| match setups.get(k as usize) {
+                Some((_, _, tri)) if tri.covers8::<L>([xs; 8], [ys; 8]) & 1 == 1 => {
                     covered |= 1 << c;
                     // Found: cull everything left.
                     f32::NEG_INFINITY

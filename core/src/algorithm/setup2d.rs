@@ -12,14 +12,18 @@ use crate::camera::View;
 use crate::clip::{
     ClipPlane, GUARD_BAND, MAX_CLIPPED, clip_triangle, fixed_guard_band, pipeline_planes,
 };
-use crate::edge::{ScreenVertex, Triangle2D, Triangle2DFixed};
+use crate::edge::{ScreenVertex, Stored, Triangle2D, Triangle2DFixed};
 use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
 
 /// Every drawable triangle, clipped, projected and set up with f32 edge
 /// functions; pieces without samples on screen are dropped.
-pub(crate) fn setup_2d(scene: &PreparedScene, view: &View, span: SampleSpan) -> Setups<Triangle2D> {
+pub(crate) fn setup_2d(
+    scene: &PreparedScene,
+    view: &View,
+    span: SampleSpan,
+) -> Setups<'static, Triangle2D> {
     setup_pieces(scene, view, span, [GUARD_BAND; 2], make_2d(view))
 }
 
@@ -39,7 +43,7 @@ pub(crate) fn setup_2d_fixed(
     scene: &PreparedScene,
     view: &View,
     span: SampleSpan,
-) -> Setups<Triangle2DFixed> {
+) -> Setups<'static, Triangle2DFixed> {
     let affine = view.is_orthographic();
     setup_pieces(scene, view, span, fixed_guard_band(view), |v| {
         let t = Triangle2DFixed::setup(v, affine)?;
@@ -59,13 +63,13 @@ pub(crate) fn setup_2d_fixed(
 /// every plane is its own clipped polygon and takes them as they are — the
 /// very values [`pieces_of`] would compute for it — while the others are
 /// clipped.
-fn setup_pieces<T: Send>(
+fn setup_pieces<T: Stored<Shared<'static> = ()>>(
     scene: &PreparedScene,
     view: &View,
     span: SampleSpan,
     guard: [f32; 2],
     make: impl Fn(&[ScreenVertex; 3]) -> Option<(T, [f32; 4])> + Sync,
-) -> Setups<T> {
+) -> Setups<'static, T> {
     let planes = pipeline_planes(view, guard);
     let kept = screen_vertices(scene, view, &planes);
     let corners = &scene.scene.mesh.triangles;
@@ -103,7 +107,11 @@ fn setup_pieces<T: Send>(
         boxes.push(b);
         triangles.push(t);
     }
-    Setups { boxes, triangles }
+    Setups {
+        boxes,
+        triangles,
+        shared: (),
+    }
 }
 
 /// The set-up pieces of the triangles `ids` after clipping (near plane and

@@ -7,7 +7,9 @@ use rayon::prelude::*;
 
 use super::tiles::{ItemBox, Setups};
 use crate::camera::View;
-use crate::edge::{CurvedTriangle, EightTriangles, HomogeneousVertex, Triangle3D, Triangle3D64};
+use crate::edge::{
+    CurvedTriangle, EightTriangles, HomogeneousVertex, Shared3D, Stored, Triangle3D, Triangle3D64,
+};
 use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
@@ -19,27 +21,39 @@ pub(crate) fn setup_3d<'a>(
     scene: &'a PreparedScene,
     view: &'a View,
     span: SampleSpan,
-) -> Setups<Triangle3D<'a>> {
-    setup_visible(scene, view, span, Triangle3D::setup_eight)
+) -> Setups<'a, Triangle3D> {
+    let shared = shared_3d(scene, view, false);
+    setup_visible(scene, view, span, shared, Triangle3D::setup_eight)
+}
+
+/// What the view's [`Triangle3D`]s share, set up by the 3D setup or the
+/// homogeneous one.
+pub(crate) fn shared_3d<'a>(
+    scene: &'a PreparedScene,
+    view: &'a View,
+    homogeneous: bool,
+) -> Shared3D<'a> {
+    let mesh = &scene.scene.mesh;
+    Shared3D::of_mesh(view, homogeneous, &mesh.positions, &mesh.triangles)
 }
 
 /// [`setup_3d`] in f64.
-pub(crate) fn setup_3d_f64(
-    scene: &PreparedScene,
-    view: &View,
+pub(crate) fn setup_3d_f64<'a>(
+    scene: &'a PreparedScene,
+    view: &'a View,
     span: SampleSpan,
-) -> Setups<Triangle3D64> {
-    setup_visible(scene, view, span, one_by_one(Triangle3D64::setup))
+) -> Setups<'a, Triangle3D64> {
+    setup_visible(scene, view, span, (), one_by_one(Triangle3D64::setup))
 }
 
 /// Every drawable triangle with samples on a non-planar viewport, set up with 3D
 /// edge functions evaluated per sample direction (paper §3.5).
-pub(crate) fn setup_curved(
-    scene: &PreparedScene,
-    view: &View,
+pub(crate) fn setup_curved<'a>(
+    scene: &'a PreparedScene,
+    view: &'a View,
     span: SampleSpan,
-) -> Setups<CurvedTriangle> {
-    setup_visible(scene, view, span, one_by_one(CurvedTriangle::setup))
+) -> Setups<'a, CurvedTriangle> {
+    setup_visible(scene, view, span, (), one_by_one(CurvedTriangle::setup))
 }
 
 /// Every drawable triangle with samples on screen, set up for homogeneous 2D
@@ -49,14 +63,15 @@ pub(crate) fn setup_homogeneous<'a>(
     scene: &'a PreparedScene,
     view: &'a View,
     span: SampleSpan,
-) -> Setups<Triangle3D<'a>> {
+) -> Setups<'a, Triangle3D> {
     let points: Vec<HomogeneousVertex> = (scene.scene.mesh.positions.par_iter())
         .map(|&p| HomogeneousVertex::of(p, view))
         .collect();
     let setup = |t: &EightTriangles<'a>, view: &'a View| {
         Triangle3D::setup_homogeneous_eight(t, &points, view)
     };
-    setup_visible(scene, view, span, setup)
+    let shared = shared_3d(scene, view, true);
+    setup_visible(scene, view, span, shared, setup)
 }
 
 /// A setup of eight triangles at a time, such as [`Triangle3D::setup_eight`].
@@ -80,12 +95,13 @@ pub(crate) fn one_by_one<'a, T>(
 /// Every BVH slot's triangle set up by `setup` with its conservative screen
 /// box, in slot order (from the scene's slot-ordered copies of positions and
 /// vertex indices: memory read in order), eight slots at a time.
-pub(crate) fn setup_slots<'a, T: Send>(
+pub(crate) fn setup_slots<'a, T: Stored>(
     scene: &'a PreparedScene,
     view: &'a View,
     span: SampleSpan,
+    shared: T::Shared<'a>,
     setup: impl SetupEight<'a, T>,
-) -> Setups<T> {
+) -> Setups<'a, T> {
     let boxes = ScreenBoxes::new(scene, view);
     let chunks = (scene.slot_corners.par_chunks(8))
         .zip(scene.slot_vertices.par_chunks(8))
@@ -99,7 +115,7 @@ pub(crate) fn setup_slots<'a, T: Send>(
         let rects = rects_of(&boxes, &mut eight, p.len(), view, span);
         paired(rects, lanes_of(ids), setup(&eight, view))
     });
-    flattened(eights.unzip(), scene.slot_triangles.len())
+    flattened(eights.unzip(), scene.slot_triangles.len(), shared)
 }
 
 /// Eight lanes' boxes (with the triangles' ids) and set-up triangles,
@@ -120,15 +136,20 @@ fn paired<T>(
     (boxes, triangles)
 }
 
-/// The first `len` items of chunks of eight.
-fn flattened<T>(
+/// The first `len` items of chunks of eight, sharing `shared`.
+fn flattened<'a, T: Stored>(
     (boxes, triangles): (Vec<[ItemBox; 8]>, Vec<[Option<T>; 8]>),
     len: usize,
-) -> Setups<T> {
+    shared: T::Shared<'a>,
+) -> Setups<'a, T> {
     let (mut boxes, mut triangles) = (boxes.into_flattened(), triangles.into_flattened());
     boxes.truncate(len);
     triangles.truncate(len);
-    Setups { boxes, triangles }
+    Setups {
+        boxes,
+        triangles,
+        shared,
+    }
 }
 
 /// Up to eight values as lanes (the last one repeated past the end).
@@ -159,12 +180,13 @@ fn rects_of(
 /// box: one item per triangle, in order (exactly sized, parallel collects of
 /// eight at a time: no chunks to concatenate); `None` for the ones off
 /// screen or edge-on.
-fn setup_visible<'a, T: Send>(
+fn setup_visible<'a, T: Stored>(
     scene: &'a PreparedScene,
     view: &'a View,
     span: SampleSpan,
+    shared: T::Shared<'a>,
     setup: impl SetupEight<'a, T>,
-) -> Setups<T> {
+) -> Setups<'a, T> {
     let boxes = ScreenBoxes::new(scene, view);
     let corners = &scene.scene.mesh.triangles;
     let eights = (scene.drawable.par_chunks(8).enumerate()).map(|(chunk, ids)| {
@@ -185,5 +207,5 @@ fn setup_visible<'a, T: Send>(
         let rects = rects_of(&boxes, &mut eight, ids.len(), view, span);
         paired(rects, lanes_of(ids), setup(&eight, view))
     });
-    flattened(eights.unzip(), scene.drawable.len())
+    flattened(eights.unzip(), scene.drawable.len(), shared)
 }

@@ -6,6 +6,7 @@
 use rayon::prelude::*;
 
 use super::{Pass, PixelRect, TileContext};
+use crate::edge::Stored;
 use crate::framebuffer::{Framebuffer, TileBuffer};
 use crate::simd;
 use crate::stats::RasterCounters;
@@ -90,30 +91,40 @@ impl ItemBox {
 
 /// Set-up triangles as two arrays of one item each: the conservative screen
 /// box and id, and apart from them the edge functions (`None` for a triangle
-/// off screen, edge-on or degenerate, whose box is [`ItemBox::NONE`]).
-/// Binning and a ray caster read the small boxes alone — 12 bytes an item,
-/// where the set-up triangle is some 100 — and the edge functions only where
-/// a box reaches their tile or their rays.
-pub(crate) struct Setups<T> {
+/// off screen, edge-on or degenerate, whose box is [`ItemBox::NONE`]); and
+/// what the view's triangles share. Binning and a ray caster read the small
+/// boxes alone — 12 bytes an item, where a set-up triangle is 64 or more —
+/// and the edge functions only where a box reaches their tile or their rays.
+pub(crate) struct Setups<'s, T: Stored> {
     pub boxes: Vec<ItemBox>,
     pub triangles: Vec<Option<T>>,
+    pub shared: T::Shared<'s>,
 }
 
-impl<T> Setups<T> {
+impl<T: Stored> Setups<'_, T> {
     /// How many items have something to test.
     pub(crate) fn placed(&self) -> u64 {
         self.boxes.iter().filter_map(|b| b.get()).count() as u64
+    }
+
+    /// Item `k`'s box, triangle id and coverage; `None` when it has nothing
+    /// to test.
+    #[inline(always)]
+    pub(crate) fn get(&self, k: usize) -> Option<(PixelRect, u32, T::Bound<'_>)> {
+        let (rect, id) = self.boxes[k].get()?;
+        let tri = self.triangles[k].as_ref()?;
+        Some((rect, id, tri.bind(&self.shared, id)))
     }
 }
 
 /// Renders `items` into `fb`, tile by tile in parallel (`None` items are
 /// triangles the setup dropped), each triangle within each tile by `kernel`
 /// (tile, triangle, id, the pixels of its box in the tile, counters).
-pub(crate) fn rasterize_tiled<T: Sync>(
+pub(crate) fn rasterize_tiled<T: Stored>(
     items: &Setups<T>,
     fb: &mut Framebuffer,
     context: &TileContext,
-    kernel: impl Fn(&mut TileBuffer, &T, u32, PixelRect, &mut RasterCounters) + Sync,
+    kernel: impl Fn(&mut TileBuffer, &T::Bound<'_>, u32, PixelRect, &mut RasterCounters) + Sync,
 ) -> Pass {
     let columns = fb.width.div_ceil(TILE_WIDTH) as usize;
     let rows = fb.height.div_ceil(TILE_HEIGHT) as usize;
@@ -178,15 +189,12 @@ pub(crate) fn rasterize_tiled<T: Sync>(
                             simd::prefetch(&items.triangles[next as usize]);
                         }
                         // Only items with a box (and so a triangle) were sorted into tiles.
-                        let k = k as usize;
-                        let (Some((rect, id)), Some(tri)) =
-                            (items.boxes[k].get(), &items.triangles[k])
-                        else {
+                        let Some((rect, id, tri)) = items.get(k as usize) else {
                             continue;
                         };
                         // Non-empty: the item was sorted into this tile by its rect.
                         if let Some(clip) = rect.intersect(tile.rect()) {
-                            kernel(tile, tri, id, clip, &mut counters);
+                            kernel(tile, &tri, id, clip, &mut counters);
                         }
                     }
                     counters

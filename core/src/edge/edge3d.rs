@@ -35,8 +35,7 @@ pub(crate) const EPS: f32 = f32::EPSILON * 0.5;
 
 /// A triangle set up for 3D rasterization against one view: per edge `i`
 /// (opposite vertex `i`) the coefficients of `E_i(x, y) = A_i + x·B_i + y·C_i`,
-/// normalised so the triangle's inside is `E_i > 0`, and the total volume
-/// `|D| = |det(p0 − e, p1 − e, p2 − e)|`.
+/// normalised so the triangle's inside is `E_i > 0`, and its depth.
 ///
 /// Depth is `w = |D| / ΣE_i` (paper Fig. 10), but `ΣE_i` is evaluated as its own
 /// linear function `N·d(x, y)` (`N` the geometric normal; equal to `ΣV_i` in real
@@ -44,31 +43,155 @@ pub(crate) const EPS: f32 = f32::EPSILON * 0.5;
 /// triangles that are small against their distance (each `E_i` is a difference of
 /// terms ~10⁵× larger): on 1M-triangle scenes that gave `w` errors of 0.1%.
 ///
+/// **One cache line.** What every triangle of a view shares — `near`, the
+/// sample generator, and the scene's vertices that the exact decisions
+/// recompute — is not stored here but in [`Shared3D`], and a triangle is read
+/// as `Coverage` bound to it ([`Triangle3D::bind`]). Of `N·d` and the
+/// volume `|D|` one is constant on the image — `|D|` in perspective, `N·d_p`
+/// in parallel projection — and is kept as one number; each edge's error
+/// tolerance is kept rounded up to a power of two (a wider tolerance only
+/// sends more samples to the exact decision, which gives the same answer).
+/// So a record is 64 bytes, aligned to a line, where it was 112: a ray or a
+/// tile reads one line per triangle, and setup writes 40% less.
+///
 /// Every algorithm of the 3D family and the ray caster decide coverage and depth
 /// through `Coverage::sample` on these coefficients, in one fixed operation
 /// order with no fused multiply-add, so they agree bit for bit.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Triangle3D<'a> {
-    pub a: [f32; 3],
-    pub b: [f32; 3],
-    pub c: [f32; 3],
-    /// `|D|` as a linear function of the image point: `w = volume(x, y) / (N·d)`.
-    /// Perspective: the constant `|D|`; orthographic: `N·(p0 − o(x, y))`.
-    pub volume: [f32; 3],
-    /// `N·d(x, y) = nd[0] + x·nd[1] + y·nd[2]`, sign-normalised like the edges.
-    pub nd: [f32; 3],
+#[repr(C, align(64))]
+pub struct Triangle3D {
+    pub(super) a: [f32; 3],
+    pub(super) b: [f32; 3],
+    pub(super) c: [f32; 3],
+    /// The part of depth that varies on the image: `N·d(x, y)` in perspective,
+    /// `|D|(x, y) = N·(p0 − o(x, y))` in parallel projection (sign-normalised
+    /// like the edges).
+    pub(super) varying: Linear,
+    /// The constant part: `|D|` in perspective, `N·d_p` in parallel projection.
+    pub(super) constant: f32,
     /// View-axis distance of the nearest and farthest vertex: every sample's `w`
     /// is clamped into this range (exact in real arithmetic, and it gives early-z
     /// and occlusion culling a bound no rounding can undercut).
-    pub w_range: [f32; 2],
-    /// Samples nearer than this are rejected.
-    pub near: f32,
+    pub(super) w_range: [f32; 2],
     /// Per edge: a certified bound on how far [`Triangle3D::edge_values`] can be
-    /// from the exact edge function anywhere on the image; within it the exact
-    /// sign decides.
-    pub tolerance: [f32; 3],
-    /// The f32 geometry the exact decisions are made on.
-    pub(super) exact: ExactEdges<'a>,
+    /// from the exact edge function anywhere on the image, within which the
+    /// exact sign decides; rounded up to a power of two ([`Tolerance`]).
+    pub(super) tolerance: [Tolerance; 3],
+    /// The edges were negated to make the inside positive.
+    pub(super) negated: bool,
+}
+
+const _: () = assert!(size_of::<Triangle3D>() == 64);
+const _: () = assert!(size_of::<Option<Triangle3D>>() == 64);
+
+/// A non-negative f32 bound rounded up to a power of two (or zero), kept as
+/// its exponent bits: one byte.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Tolerance(u8);
+
+impl Tolerance {
+    /// The least power of two at or above `t` (`t` finite and `≥ 0`; zero
+    /// stays zero; beyond the largest finite power it is infinite).
+    #[inline(always)]
+    pub(super) fn above(t: f32) -> Tolerance {
+        let bits = t.to_bits() & 0x7fff_ffff;
+        let exponent = (bits >> 23) + u32::from(bits & 0x7f_ffff != 0);
+        Tolerance(exponent.min(255) as u8)
+    }
+
+    /// The bound.
+    #[inline(always)]
+    pub(crate) fn get(self) -> f32 {
+        f32::from_bits(u32::from(self.0) << 23)
+    }
+}
+
+/// What every [`Triangle3D`] of one view shares: the view (`near`, the
+/// sample generator), which setup made them, and the scene's vertices by
+/// triangle id, from which the rare exact decisions recompute the edges.
+#[derive(Clone, Copy, Debug)]
+pub struct Shared3D<'a> {
+    view: &'a View,
+    near: f32,
+    /// Parallel projection: the depth's constant part is `N·d_p`, not `|D|`.
+    parallel: bool,
+    form: ExactForm,
+    corners: Corners<'a>,
+}
+
+/// Where a view's triangles' vertices are, by triangle id.
+#[derive(Clone, Copy, Debug)]
+enum Corners<'a> {
+    /// A mesh: vertex positions and each triangle's three indices.
+    Indexed {
+        positions: &'a [Vec3],
+        triangles: &'a [[u32; 3]],
+    },
+    /// Each triangle's three corners.
+    Listed(&'a [[Vec3; 3]]),
+}
+
+impl<'a> Shared3D<'a> {
+    /// The triangles of a mesh (`positions`, `triangles` by id) set up for
+    /// `view` by the 3D setup ([`Triangle3D::setup`]) or the homogeneous one.
+    pub(crate) fn of_mesh(
+        view: &'a View,
+        homogeneous: bool,
+        positions: &'a [Vec3],
+        triangles: &'a [[u32; 3]],
+    ) -> Shared3D<'a> {
+        Self::new(
+            view,
+            homogeneous,
+            Corners::Indexed {
+                positions,
+                triangles,
+            },
+        )
+    }
+
+    /// Triangles with these corners, by index, set up for `view` by
+    /// [`Triangle3D::setup`] or (`homogeneous`) the homogeneous setup.
+    pub fn of_corners(view: &'a View, homogeneous: bool, corners: &'a [[Vec3; 3]]) -> Shared3D<'a> {
+        Self::new(view, homogeneous, Corners::Listed(corners))
+    }
+
+    fn new(view: &'a View, homogeneous: bool, corners: Corners<'a>) -> Shared3D<'a> {
+        let parallel = view.is_orthographic();
+        let form = match (homogeneous, parallel) {
+            (true, _) => ExactForm::Homogeneous,
+            (false, true) => ExactForm::Orthographic,
+            (false, false) => ExactForm::Perspective,
+        };
+        Shared3D {
+            view,
+            near: view.near,
+            parallel,
+            form,
+            corners,
+        }
+    }
+
+    /// Triangle `id`'s corners as its setup read them.
+    fn corners(&self, id: u32) -> [Vec3; 3] {
+        match self.corners {
+            Corners::Indexed {
+                positions,
+                triangles,
+            } => triangles[id as usize].map(|v| positions[v as usize]),
+            Corners::Listed(corners) => corners[id as usize],
+        }
+    }
+}
+
+/// A [`Triangle3D`] read with what its view shares, as every coverage loop
+/// sees it ([`Coverage`]): the record, the shared data and the triangle's id
+/// (for the exact decisions), three words in registers.
+#[derive(Clone, Copy, Debug)]
+pub struct Bound3D<'a> {
+    t: &'a Triangle3D,
+    shared: &'a Shared3D<'a>,
+    id: u32,
 }
 
 /// Which exact edge functions a [`Triangle3D`] stands for.
@@ -82,31 +205,25 @@ pub(crate) enum ExactForm {
     Homogeneous,
 }
 
-/// What the exact decisions need: the vertices (as the setup rounded them,
-/// recomputed on demand from the scene's own), the view, and the orientation.
+/// What the exact decisions need: the vertices (as the setup read them), the
+/// view, and the orientation.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct ExactEdges<'a> {
+struct ExactEdges<'a> {
     form: ExactForm,
-    vertices: &'a [Vec3; 3],
+    vertices: [Vec3; 3],
     view: &'a View,
     /// The edges were negated to make the inside positive.
     negated: bool,
 }
 
-impl<'a> ExactEdges<'a> {
-    pub(crate) fn new(
-        form: ExactForm,
-        vertices: &'a [Vec3; 3],
-        view: &'a View,
-        negated: bool,
-    ) -> ExactEdges<'a> {
-        ExactEdges {
-            form,
-            vertices,
-            view,
-            negated,
-        }
-    }
+/// The depth's two linear functions as a setup computed them: of `N·d` and
+/// the volume one is constant on the image.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Depth {
+    /// `N·d(x, y)` varies, the volume `|D|` is constant (perspective).
+    Perspective { facing: Linear, volume: f32 },
+    /// `N·d_p` is constant, the volume `N·(p0 − o(x, y))` varies.
+    Parallel { facing: f32, volume: Linear },
 }
 
 /// The midpoint edge normal `(e − (a+b)/2) × (a − b)` of §3.4 with `a` and `b`
@@ -193,17 +310,17 @@ fn perspective_edge(a: Vec3, b: Vec3, sign: f32, d_abs: Vec3, view: &View) -> (L
     (along(edge_normal(a, b) * sign, view), error)
 }
 
-impl<'a> Triangle3D<'a> {
+impl Triangle3D {
     /// Paper §3.2 setup: three edge normals, their derivatives along the sample
     /// generator, and the triangle's volume as seen from the eye. `None` when the
     /// triangle is seen exactly edge-on (`D = 0`) or the values are not finite.
     #[inline]
-    pub fn setup(p: &'a [Vec3; 3], view: &'a View) -> Option<Triangle3D<'a>> {
+    pub fn setup(p: &[Vec3; 3], view: &View) -> Option<Triangle3D> {
         // 1. Vertices relative to the eye (exact for geometry near the camera,
         //    however far both are from the world origin).
         let c = p.map(|v| v - view.eye);
         if view.is_orthographic() {
-            return Self::setup_orthographic(p, &c, view);
+            return Self::setup_orthographic(&c, view);
         }
         let w = c.map(|v| v.dot(view.forward));
         // 2. Vertices 10¹² away would overflow D's products (~|c|³): scaled by a
@@ -230,26 +347,18 @@ impl<'a> Triangle3D<'a> {
         let (e1, r1) = perspective_edge(c[2], c[0], sign, d_abs, view);
         let (e2, r2) = perspective_edge(c[0], c[1], sign, d_abs, view);
         // w = |D|/(N·d) is homogeneous of degree 1 in the vertices: undo the scale.
-        Triangle3D::from_linear(
-            [e0, e1, e2],
-            along(normal * sign, view),
-            [d.abs() * scale, 0.0, 0.0],
-            w,
-            view,
-            [r0, r1, r2],
-            ExactEdges::new(ExactForm::Perspective, p, view, !positive),
-        )
+        let depth = Depth::Perspective {
+            facing: along(normal * sign, view),
+            volume: d.abs() * scale,
+        };
+        Triangle3D::from_linear([e0, e1, e2], depth, w, view, [r0, r1, r2], !positive)
     }
 
     /// Paper §3.3: orthographic setup, `n_i = d_p × (p_{i+1} − p_{i+2})` and
     /// `V_i = n_i · (m_i − o(x, y))`; the depth `w = N·(p0 − o(x, y)) / (N·d_p)`.
     /// `c` are the vertices relative to the eye. `None` when the triangle is
     /// seen edge-on (`N·d_p = 0`).
-    fn setup_orthographic(
-        p: &'a [Vec3; 3],
-        c: &[Vec3; 3],
-        view: &'a View,
-    ) -> Option<Triangle3D<'a>> {
+    fn setup_orthographic(c: &[Vec3; 3], view: &View) -> Option<Triangle3D> {
         let dp = view.forward;
         let w = c.map(|v| v.dot(dp));
         // Far vertices and the ray origins scaled together by a power of two
@@ -281,56 +390,67 @@ impl<'a> Triangle3D<'a> {
             coefficient_error[i] = 8.0 * EPS * abs_cross(dp, a - b).dot(q.abs() + o_abs);
             toward(dp.cross(a - b) * sign, q)
         });
-        Triangle3D::from_linear(
-            edges,
-            [facing.abs(), 0.0, 0.0],
-            toward(normal * sign, c[0]).map(|v| v * scale),
-            w,
-            view,
-            coefficient_error,
-            ExactEdges::new(ExactForm::Orthographic, p, view, !positive),
-        )
+        let depth = Depth::Parallel {
+            facing: facing.abs(),
+            volume: toward(normal * sign, c[0]).map(|v| v * scale),
+        };
+        Triangle3D::from_linear(edges, depth, w, view, coefficient_error, !positive)
     }
 
     /// Assembles a triangle from its three sign-normalised edge functions, the
-    /// depth as a ratio of linear functions `w = volume / nd`, its vertices' `w`,
-    /// the bound on each edge's coefficient error over the image, and the exact
-    /// edges it stands for; adds the evaluation's rounding to the tolerance.
-    /// `None` on non-finite values.
+    /// depth as a ratio of linear functions `w = volume / (N·d)`, its
+    /// vertices' `w`, the bound on each edge's coefficient error over the
+    /// image, and whether the edges were negated; adds the evaluation's
+    /// rounding to the tolerance. `None` on non-finite values.
     #[inline(always)]
     pub(crate) fn from_linear(
         edges: [Linear; 3],
-        nd: Linear,
-        volume: Linear,
+        depth: Depth,
         vertex_w: [f32; 3],
         view: &View,
         coefficient_error: [f32; 3],
-        exact: ExactEdges<'a>,
-    ) -> Option<Triangle3D<'a>> {
+        negated: bool,
+    ) -> Option<Triangle3D> {
         let (x_max, y_max) = image_extent(view);
-        let t = Triangle3D {
+        // (A + x·B) + y·C rounds four times, each by at most ε of the sum of
+        // the terms' magnitudes; both bounds doubled for margin.
+        let tolerance: [f32; 3] = std::array::from_fn(|i| {
+            let e = edges[i];
+            let evaluation = 4.0 * EPS * (e[0].abs() + x_max * e[1].abs() + y_max * e[2].abs());
+            2.0 * (coefficient_error[i] + evaluation)
+        });
+        let (varying, constant) = match depth {
+            Depth::Perspective { facing, volume } => (facing, volume),
+            Depth::Parallel { facing, volume } => (volume, facing),
+        };
+        let w_range = [
+            vertex_w[0].min(vertex_w[1]).min(vertex_w[2]),
+            vertex_w[0].max(vertex_w[1]).max(vertex_w[2]),
+        ];
+        let finite = all_finite(&[edges[0], edges[1], edges[2], varying, tolerance])
+            && constant.is_finite()
+            && w_range.iter().all(|w| w.is_finite());
+        finite.then(|| Triangle3D {
             a: edges.map(|e| e[0]),
             b: edges.map(|e| e[1]),
             c: edges.map(|e| e[2]),
-            nd,
-            volume,
-            w_range: [
-                vertex_w[0].min(vertex_w[1]).min(vertex_w[2]),
-                vertex_w[0].max(vertex_w[1]).max(vertex_w[2]),
-            ],
-            near: view.near,
-            // (A + x·B) + y·C rounds four times, each by at most ε of the sum of
-            // the terms' magnitudes; both bounds doubled for margin.
-            tolerance: std::array::from_fn(|i| {
-                let e = edges[i];
-                let evaluation = 4.0 * EPS * (e[0].abs() + x_max * e[1].abs() + y_max * e[2].abs());
-                2.0 * (coefficient_error[i] + evaluation)
-            }),
-            exact,
-        };
-        let finite = all_finite(&[edges[0], edges[1], edges[2], nd, volume, t.tolerance])
-            && t.w_range.iter().all(|w| w.is_finite());
-        finite.then_some(t)
+            varying,
+            constant,
+            w_range,
+            tolerance: tolerance.map(Tolerance::above),
+            negated,
+        })
+    }
+
+    /// This triangle (triangle `id` of the view `shared` describes) read as
+    /// `Coverage`.
+    #[inline(always)]
+    pub fn bind<'s>(&'s self, shared: &'s Shared3D<'s>, id: u32) -> Bound3D<'s> {
+        Bound3D {
+            t: self,
+            shared,
+            id,
+        }
     }
 
     /// The three edge values at image point `(x, y)`: `(A + x·B) + y·C`.
@@ -348,57 +468,87 @@ impl<'a> Triangle3D<'a> {
     /// row 3 `(volume, w_min)`, row 4 `(w_max, 0, 0, 0)`, row 5 the
     /// tolerances; and the flags (tie ownership per edge by the f32
     /// derivatives, which the kernels use only where an edge has no
-    /// tolerance).
+    /// tolerance). `parallel`: set up for a parallel projection.
     #[cfg(feature = "gpu")]
-    pub(crate) fn gpu_rows(&self) -> ([[f32; 4]; 6], u32) {
+    pub(crate) fn gpu_rows(&self, parallel: bool) -> ([[f32; 4]; 6], u32) {
         let mut flags = 0;
         for i in 0..3 {
             let (b, c) = (self.b[i], self.c[i]);
             flags |= u32::from(b > 0.0 || (b == 0.0 && c > 0.0)) << i;
         }
-        let [t0, t1, t2] = self.tolerance;
+        let [t0, t1, t2] = self.tolerance.map(Tolerance::get);
+        let constant = [self.constant, 0.0, 0.0];
+        let (nd, volume) = if parallel {
+            (constant, self.varying)
+        } else {
+            (self.varying, constant)
+        };
         let rows = [
-            [self.a[0], self.a[1], self.a[2], self.nd[0]],
-            [self.b[0], self.b[1], self.b[2], self.nd[1]],
-            [self.c[0], self.c[1], self.c[2], self.nd[2]],
-            [
-                self.volume[0],
-                self.volume[1],
-                self.volume[2],
-                self.w_range[0],
-            ],
+            [self.a[0], self.a[1], self.a[2], nd[0]],
+            [self.b[0], self.b[1], self.b[2], nd[1]],
+            [self.c[0], self.c[1], self.c[2], nd[2]],
+            [volume[0], volume[1], volume[2], self.w_range[0]],
             [self.w_range[1], 0.0, 0.0, 0.0],
             [t0, t1, t2, 0.0],
         ];
         (rows, flags)
     }
+}
 
+impl Bound3D<'_> {
     /// Is the sample at `(x, y)` with f32 edge values `e` inside all three
     /// edges? The f32 sign where it is certain, the exact one where it is not.
     #[inline(always)]
     fn inside(&self, e: [f32; 3], x: f32, y: f32) -> bool {
         (0..3).all(|i| {
-            if e[i] > self.tolerance[i] {
+            let tolerance = self.t.tolerance[i].get();
+            if e[i] > tolerance {
                 true
-            } else if e[i] < -self.tolerance[i] {
+            } else if e[i] < -tolerance {
                 false
             } else {
-                self.exact.inside(i, x, y)
+                self.exact().inside(i, x, y)
             }
         })
+    }
+
+    /// The exact edges this triangle stands for.
+    #[cold]
+    fn exact(&self) -> ExactEdges<'_> {
+        ExactEdges {
+            form: self.shared.form,
+            vertices: self.shared.corners(self.id),
+            view: self.shared.view,
+            negated: self.t.negated,
+        }
+    }
+
+    /// `N·d` and the volume at `(x, y)`: `k[0] + x·k[1] + y·k[2]` for the
+    /// varying one, the constant as it is (what that sum gives when
+    /// `k[1] = k[2] = 0`, for every sample: `k[0] + ±0 = k[0]` but for zero,
+    /// and a zero `N·d` is rejected, a zero volume is `+0` either way).
+    #[inline(always)]
+    fn facing_and_volume(&self, x: f32, y: f32) -> (f32, f32) {
+        let k = self.t.varying;
+        let varying = k[0] + x * k[1] + y * k[2];
+        if self.shared.parallel {
+            (self.t.constant, varying)
+        } else {
+            (varying, self.t.constant)
+        }
     }
 
     /// `w = |D| / (N·d)`, clamped to the vertices' range; `None` below `near`.
     #[inline(always)]
     fn depth(&self, x: f32, y: f32) -> Option<f32> {
-        let facing = self.nd[0] + x * self.nd[1] + y * self.nd[2];
+        let (facing, volume) = self.facing_and_volume(x, y);
         if facing <= 0.0 {
             return None;
         }
-        let volume = self.volume[0] + x * self.volume[1] + y * self.volume[2];
+        let [w_min, w_max] = self.t.w_range;
         // max/min rather than clamp: never panics, and the 8-lane path rounds alike.
-        let w = (volume / facing).max(self.w_range[0]).min(self.w_range[1]);
-        (w >= self.near).then_some(w)
+        let w = (volume / facing).max(w_min).min(w_max);
+        (w >= self.shared.near).then_some(w)
     }
 }
 
@@ -563,21 +713,33 @@ impl ExactEdges<'_> {
 /// The 8-lane forms of the scalar operations (no fused multiply-add, the same
 /// operation order, so every lane rounds as [`Coverage::sample`] does), on
 /// either instruction set ([`crate::simd`]).
-impl Triangle3D<'_> {
+impl Bound3D<'_> {
     /// `k[0] + x·k[1] + y·k[2]` per lane, in [`Triangle3D::edge_values`]'s order.
     #[inline(always)]
     fn linear_lanes<L: Lanes>(k: [f32; 3], x: L, y: L) -> L {
         L::splat(k[0]) + x * L::splat(k[1]) + y * L::splat(k[2])
     }
 
+    /// [`Bound3D::facing_and_volume`] per lane.
+    #[inline(always)]
+    fn facing_and_volume_lanes<L: Lanes>(&self, x: L, y: L) -> (L, L) {
+        let varying = Self::linear_lanes(self.t.varying, x, y);
+        let constant = L::splat(self.t.constant);
+        if self.shared.parallel {
+            (constant, varying)
+        } else {
+            (varying, constant)
+        }
+    }
+
     #[inline(always)]
     fn sample_lanes<L: Lanes>(&self, x: L, y: L, active: u8) -> (u8, [f32; 8]) {
-        let facing = Self::linear_lanes(self.nd, x, y);
+        let (facing, volume) = self.facing_and_volume_lanes(x, y);
         let inside = self.edges_lanes(x, y, active & facing.gt(L::splat(0.0)));
         if inside == 0 {
             return (0, [0.0; 8]);
         }
-        self.depth_lanes(x, y, facing, inside)
+        self.depth_lanes(facing, volume, inside)
     }
 
     /// The lanes of `active` whose points are inside all three edges: the f32
@@ -585,11 +747,13 @@ impl Triangle3D<'_> {
     /// are not.
     #[inline(always)]
     fn edges_lanes<L: Lanes>(&self, x: L, y: L, active: u8) -> u8 {
+        let t = self.t;
         let (mut certain_in, mut certain_out) = (active, !active);
         for k in 0..3 {
-            let e = Self::linear_lanes([self.a[k], self.b[k], self.c[k]], x, y);
-            certain_in &= e.gt(L::splat(self.tolerance[k]));
-            certain_out |= e.lt(L::splat(-self.tolerance[k]));
+            let e = Self::linear_lanes([t.a[k], t.b[k], t.c[k]], x, y);
+            let tolerance = t.tolerance[k].get();
+            certain_in &= e.gt(L::splat(tolerance));
+            certain_out |= e.lt(L::splat(-tolerance));
         }
         let undecided = !(certain_in | certain_out);
         if undecided == 0 {
@@ -607,7 +771,7 @@ impl Triangle3D<'_> {
         while undecided != 0 {
             let l = undecided.trailing_zeros() as usize;
             undecided &= undecided - 1;
-            if self.inside(self.edge_values(xs[l], ys[l]), xs[l], ys[l]) {
+            if self.inside(self.t.edge_values(xs[l], ys[l]), xs[l], ys[l]) {
                 inside |= 1 << l;
             }
         }
@@ -616,20 +780,18 @@ impl Triangle3D<'_> {
 
     /// `w` per lane, and `mask` narrowed to the lanes at or beyond `near`.
     #[inline(always)]
-    fn depth_lanes<L: Lanes>(&self, x: L, y: L, facing: L, mask: u8) -> (u8, [f32; 8]) {
-        let volume = Self::linear_lanes(self.volume, x, y);
-        let w = (volume / facing)
-            .max(L::splat(self.w_range[0]))
-            .min(L::splat(self.w_range[1]));
-        let mask = mask & w.ge(L::splat(self.near));
+    fn depth_lanes<L: Lanes>(&self, facing: L, volume: L, mask: u8) -> (u8, [f32; 8]) {
+        let [w_min, w_max] = self.t.w_range;
+        let w = (volume / facing).max(L::splat(w_min)).min(L::splat(w_max));
+        let mask = mask & w.ge(L::splat(self.shared.near));
         (mask, w.to_array())
     }
 }
 
-impl Coverage for Triangle3D<'_> {
+impl Coverage for Bound3D<'_> {
     #[inline(always)]
     fn sample(&self, x: f32, y: f32) -> Option<f32> {
-        if self.inside(self.edge_values(x, y), x, y) {
+        if self.inside(self.t.edge_values(x, y), x, y) {
             self.depth(x, y)
         } else {
             None
@@ -649,13 +811,13 @@ impl Coverage for Triangle3D<'_> {
         let mut lo = [f32::INFINITY; 3];
         let mut hi = [f32::NEG_INFINITY; 3];
         for (x, y) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1)] {
-            let e = self.edge_values(x, y);
+            let e = self.t.edge_values(x, y);
             for k in 0..3 {
                 lo[k] = lo[k].min(e[k]);
                 hi[k] = hi[k].max(e[k]);
             }
         }
-        let t = self.tolerance;
+        let t = self.t.tolerance.map(Tolerance::get);
         if (0..3).any(|k| hi[k] < -t[k]) {
             BlockTest::Outside
         } else if (0..3).all(|k| lo[k] > 3.0 * t[k]) {
@@ -675,21 +837,21 @@ impl Coverage for Triangle3D<'_> {
     #[inline(always)]
     fn covers8<L: Lanes>(&self, x: [f32; 8], y: [f32; 8]) -> u8 {
         let (x, y) = (L::from_array(x), L::from_array(y));
-        let facing = Self::linear_lanes(self.nd, x, y);
-        let volume = Self::linear_lanes(self.volume, x, y);
-        let front = facing.gt(L::splat(0.0)) & volume.ge(facing * L::splat(self.near));
+        let (facing, volume) = self.facing_and_volume_lanes(x, y);
+        let near = L::splat(self.shared.near);
+        let front = facing.gt(L::splat(0.0)) & volume.ge(facing * near);
         self.edges_lanes(x, y, front)
     }
 
     #[inline(always)]
     fn depth_inside8<L: Lanes>(&self, x: [f32; 8], y: [f32; 8]) -> (u8, [f32; 8]) {
         let (x, y) = (L::from_array(x), L::from_array(y));
-        let facing = Self::linear_lanes(self.nd, x, y);
-        self.depth_lanes(x, y, facing, facing.gt(L::splat(0.0)))
+        let (facing, volume) = self.facing_and_volume_lanes(x, y);
+        self.depth_lanes(facing, volume, facing.gt(L::splat(0.0)))
     }
 
     fn min_depth(&self) -> f32 {
-        self.w_range[0].max(self.near)
+        self.t.w_range[0].max(self.shared.near)
     }
 }
 
@@ -732,6 +894,44 @@ mod tests {
     #[cfg(target_arch = "x86_64")]
     use crate::edge::lanes_test::lanes_agree_avx2;
 
+    /// A tolerance is kept as the least power of two at or above it: never
+    /// below it (a narrower bound would trust uncertain f32 signs), less
+    /// than twice it, zero as zero, subnormals and the largest values too.
+    #[test]
+    fn tolerances_round_up_to_the_next_power_of_two() {
+        let mut rng = fastrand::Rng::with_seed(5);
+        let mut cases = vec![
+            0.0,
+            f32::from_bits(1),
+            f32::MIN_POSITIVE,
+            1.0,
+            1.5,
+            3.0e-7,
+            2e38,
+        ];
+        cases.extend((0..10_000).map(|_| f32::from_bits(rng.u32(0..0x7f80_0000))));
+        for &t in &cases {
+            let kept = Tolerance::above(t).get();
+            assert!(kept >= t, "{t:e} kept as {kept:e}");
+            assert_eq!(
+                kept.to_bits() & 0x7f_ffff,
+                0,
+                "{kept:e} is not a power of two"
+            );
+            if t == 0.0 {
+                assert_eq!(kept, 0.0);
+            } else if t <= 2f32.powi(127) {
+                assert!(
+                    kept < 2.0 * t || kept == f32::MIN_POSITIVE,
+                    "{t:e} kept as {kept:e}"
+                );
+            } else {
+                assert_eq!(kept, f32::INFINITY, "{t:e}");
+            }
+        }
+        assert_eq!(cases.len(), 10_007);
+    }
+
     /// Every 8-lane method gives exactly the scalar path's coverage and depth
     /// in the lanes it is asked for (and nothing in the others), on the
     /// portable lanes and on AVX2, on random triangles near and through the
@@ -766,6 +966,9 @@ mod tests {
             let Some(t) = Triangle3D::setup(&p, &view) else {
                 continue;
             };
+            let corners = [p];
+            let shared = Shared3D::of_corners(&view, false, &corners);
+            let t = t.bind(&shared, 0);
             // Every lane, or a different part of them per triangle.
             let active = if n % 2 == 0 {
                 0xff

@@ -13,20 +13,15 @@
 use glam::Vec3;
 
 use super::EightTriangles;
-use super::edge3d::{
-    EPS, ExactEdges, ExactForm, HomogeneousVertex, SCALE_ABOVE, Triangle3D, image_extent,
-};
+use super::edge3d::{EPS, HomogeneousVertex, SCALE_ABOVE, Tolerance, Triangle3D, image_extent};
 use super::homogeneous::setup_homogeneous_from;
 use crate::camera::View;
 use crate::simd::{self, Lanes};
 
-impl<'a> Triangle3D<'a> {
+impl Triangle3D {
     /// The triangles of `t` set up for `view`, each exactly as
     /// [`Triangle3D::setup`] sets it up.
-    pub(crate) fn setup_eight(
-        t: &EightTriangles<'a>,
-        view: &'a View,
-    ) -> [Option<Triangle3D<'a>>; 8] {
+    pub(crate) fn setup_eight(t: &EightTriangles, view: &View) -> [Option<Triangle3D>; 8] {
         setup_eight_with(t.corners, t.present, view, perspective_lanes)
     }
 
@@ -34,25 +29,25 @@ impl<'a> Triangle3D<'a> {
     /// their transformed vertices (`points`, indexed by `t.vertices`), each
     /// exactly as [`setup_homogeneous_from`] sets it up.
     pub(crate) fn setup_homogeneous_eight(
-        t: &EightTriangles<'a>,
+        t: &EightTriangles,
         points: &[HomogeneousVertex],
-        view: &'a View,
-    ) -> [Option<Triangle3D<'a>>; 8] {
+        view: &View,
+    ) -> [Option<Triangle3D>; 8] {
         homogeneous_eight_with(t, points, view, homogeneous_lanes)
     }
 }
 
 /// [`Triangle3D::setup_homogeneous_eight`] with the lanes computed by `kernel`.
 #[inline(always)]
-fn homogeneous_eight_with<'a>(
-    t: &EightTriangles<'a>,
+fn homogeneous_eight_with(
+    t: &EightTriangles,
     points: &[HomogeneousVertex],
-    view: &'a View,
+    view: &View,
     kernel: fn(&Corners, &[[f32; 8]; 3], &View) -> LaneSetups,
-) -> [Option<Triangle3D<'a>>; 8] {
+) -> [Option<Triangle3D>; 8] {
     let vertices = |l: usize| t.vertices[l].map(|v| points[v as usize]);
     if view.is_orthographic() {
-        return t.each(|l| setup_homogeneous_from(t.corners[l], vertices(l), view));
+        return t.each(|l| setup_homogeneous_from(vertices(l), view));
     }
     // Absent lanes stay at zero: degenerate, undecided.
     let (mut h, mut w): (Corners, [[f32; 8]; 3]) = Default::default();
@@ -65,14 +60,7 @@ fn homogeneous_eight_with<'a>(
         }
     }
     let s = kernel(&h, &w, view);
-    assembled(
-        t.corners,
-        t.present,
-        &s,
-        ExactForm::Homogeneous,
-        view,
-        |l| setup_homogeneous_from(t.corners[l], vertices(l), view),
-    )
+    assembled(t.present, &s, |l| setup_homogeneous_from(vertices(l), view))
 }
 
 /// Vertex, axis, lane.
@@ -80,12 +68,12 @@ type Corners = [[[f32; 8]; 3]; 3];
 
 /// [`setup_eight`] with the perspective lanes computed by `kernel`.
 #[inline(always)]
-fn setup_eight_with<'a>(
-    p: [&'a [Vec3; 3]; 8],
+fn setup_eight_with(
+    p: [&[Vec3; 3]; 8],
     present: u8,
-    view: &'a View,
+    view: &View,
     kernel: fn(&Corners, &View) -> LaneSetups,
-) -> [Option<Triangle3D<'a>>; 8] {
+) -> [Option<Triangle3D>; 8] {
     if view.is_orthographic() {
         return std::array::from_fn(|l| {
             (present >> l & 1 == 1)
@@ -104,43 +92,37 @@ fn setup_eight_with<'a>(
         }
     }
     let s = kernel(&corners, view);
-    assembled(p, present, &s, ExactForm::Perspective, view, |l| {
-        Triangle3D::setup(p[l], view)
-    })
+    assembled(present, &s, |l| Triangle3D::setup(p[l], view))
 }
 
 /// The present lanes' triangles from what the lanes computed: a decided
 /// lane's values as they are, an undecided one set up by `scalar`.
 #[inline(always)]
-fn assembled<'a>(
-    p: [&'a [Vec3; 3]; 8],
+fn assembled(
     present: u8,
     s: &LaneSetups,
-    form: ExactForm,
-    view: &'a View,
-    scalar: impl Fn(usize) -> Option<Triangle3D<'a>>,
-) -> [Option<Triangle3D<'a>>; 8] {
+    scalar: impl Fn(usize) -> Option<Triangle3D>,
+) -> [Option<Triangle3D>; 8] {
     let mut out = [None; 8];
-    for l in 0..8 {
+    for (l, out) in out.iter_mut().enumerate() {
         if present >> l & 1 == 0 {
             continue;
         }
         if s.decided >> l & 1 == 0 {
-            out[l] = scalar(l);
+            *out = scalar(l);
             continue;
         }
         let edge = |j: usize| [s.edges[0][j][l], s.edges[1][j][l], s.edges[2][j][l]];
         let w = [s.w[0][l], s.w[1][l], s.w[2][l]];
-        out[l] = Some(Triangle3D {
+        *out = Some(Triangle3D {
             a: edge(0),
             b: edge(1),
             c: edge(2),
-            volume: [s.volume[l], 0.0, 0.0],
-            nd: [s.nd[0][l], s.nd[1][l], s.nd[2][l]],
+            varying: [s.nd[0][l], s.nd[1][l], s.nd[2][l]],
+            constant: s.volume[l],
             w_range: [w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2])],
-            near: view.near,
-            tolerance: [s.tolerance[0][l], s.tolerance[1][l], s.tolerance[2][l]],
-            exact: ExactEdges::new(form, p[l], view, s.negated >> l & 1 == 1),
+            tolerance: [0, 1, 2].map(|k| Tolerance::above(s.tolerance[k][l])),
+            negated: s.negated >> l & 1 == 1,
         });
     }
     out
@@ -587,7 +569,7 @@ mod tests {
                 for (l, lane) in lanes.iter().enumerate() {
                     let vertices = t.vertices[l].map(|v| points[v as usize]);
                     let scalar = (t.present >> l & 1 == 1)
-                        .then(|| setup_homogeneous_from(t.corners[l], vertices, &view))
+                        .then(|| setup_homogeneous_from(vertices, &view))
                         .flatten();
                     assert!(
                         same(lane, &scalar),

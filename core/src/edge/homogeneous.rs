@@ -12,9 +12,7 @@
 use glam::Vec3;
 
 use super::Triangle3D;
-use super::edge3d::{
-    EPS, ExactEdges, ExactForm, HomogeneousVertex, abs_cross, image_extent, orientation, scaled,
-};
+use super::edge3d::{Depth, EPS, HomogeneousVertex, abs_cross, image_extent, orientation, scaled};
 use super::exact;
 use crate::camera::View;
 
@@ -23,11 +21,10 @@ use crate::camera::View;
 /// three cross products and the determinant. `None` when the determinant is
 /// zero (degenerate or seen edge-on). Orthographic views have `W = 1` at
 /// every vertex, and `w` is interpolated linearly: `w = Σ w_i·E_i / ΣE_i`.
-pub(crate) fn setup_homogeneous_from<'a>(
-    p: &'a [Vec3; 3],
+pub(crate) fn setup_homogeneous_from(
     vertices: [HomogeneousVertex; 3],
-    view: &'a View,
-) -> Option<Triangle3D<'a>> {
+    view: &View,
+) -> Option<Triangle3D> {
     // 1. Camera space → homogeneous pixel coordinates (X, Y, W), x = X/W.
     let orthographic = view.is_orthographic();
     let w = vertices.map(|v| v.w);
@@ -55,11 +52,19 @@ pub(crate) fn setup_homogeneous_from<'a>(
     let sign = if positive { 1.0 } else { -1.0 };
     let linear = |r: Vec3| [r.z * sign, r.x * sign, r.y * sign];
     // w is homogeneous of degree 1 in h (orthographic: 0, W = 1 and the rows
-    // scale like the normal).
-    let volume = if orthographic {
-        linear(rows[0] * w[0] + rows[1] * w[1] + rows[2] * w[2])
+    // scale like the normal). Orthographic vertices all have W = 1 (scaled
+    // alike), so both edges of the normal's cross product have z = 0
+    // exactly and its x and y are ±0: N·(x, y, 1) is the constant N_z.
+    let depth = if orthographic {
+        Depth::Parallel {
+            facing: normal.z * sign,
+            volume: linear(rows[0] * w[0] + rows[1] * w[1] + rows[2] * w[2]),
+        }
     } else {
-        [det.abs() * scale, 0.0, 0.0]
+        Depth::Perspective {
+            facing: linear(normal),
+            volume: det.abs() * scale,
+        }
     };
     // Each row's rounding is at most 5ε of |m| ⊗ |u|, evaluated at (x, y, 1).
     let (x_max, y_max) = image_extent(view);
@@ -70,11 +75,10 @@ pub(crate) fn setup_homogeneous_from<'a>(
     });
     Triangle3D::from_linear(
         rows.map(linear),
-        linear(normal),
-        volume,
+        depth,
         w,
         view,
         coefficient_error,
-        ExactEdges::new(ExactForm::Homogeneous, p, view, !positive),
+        !positive,
     )
 }

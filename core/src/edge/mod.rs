@@ -26,7 +26,7 @@ pub use edge2d::{ScreenVertex, Triangle2D};
 pub use edge2d_fixed::Triangle2DFixed;
 pub(crate) use edge3d::EPS;
 pub(crate) use edge3d::HomogeneousVertex;
-pub use edge3d::Triangle3D;
+pub use edge3d::{Bound3D, Shared3D, Triangle3D};
 pub use edge3d_f64::Triangle3D64;
 // The GPU's exact fallback sets up one triangle at a time; the CPU, eight
 // (`Triangle3D::setup_homogeneous_eight`).
@@ -79,6 +79,47 @@ impl EightTriangles<'_> {
 }
 
 use crate::simd::{Lanes, first_lanes};
+
+/// A set-up triangle as a setup stores it, and how a coverage loop reads
+/// it: bound to what every triangle of its view shares and to its id. A
+/// [`Triangle3D`] keeps its view's data in a [`Shared3D`] to fit a cache
+/// line; the other set-up triangles hold everything they need and are read
+/// as they are.
+pub(crate) trait Stored: Send + Sync {
+    /// What every triangle of one view shares.
+    type Shared<'s>: Sync;
+    /// The triangle as the coverage loops read it.
+    type Bound<'b>: Coverage
+    where
+        Self: 'b;
+    /// Triangle `id`, set up for the view `shared` describes, as [`Coverage`].
+    fn bind<'b, 's: 'b>(&'b self, shared: &'b Self::Shared<'s>, id: u32) -> Self::Bound<'b>;
+}
+
+impl Stored for Triangle3D {
+    type Shared<'s> = Shared3D<'s>;
+    type Bound<'b> = Bound3D<'b>;
+    #[inline(always)]
+    fn bind<'b, 's: 'b>(&'b self, shared: &'b Shared3D<'s>, id: u32) -> Bound3D<'b> {
+        Triangle3D::bind(self, shared, id)
+    }
+}
+
+/// [`Stored`] for set-up triangles that are their own coverage.
+macro_rules! stored_as_they_are {
+    ($($t:ty),*) => {$(
+        impl Stored for $t {
+            type Shared<'s> = ();
+            type Bound<'b> = &'b $t;
+            #[inline(always)]
+            fn bind<'b, 's: 'b>(&'b self, _: &'b (), _: u32) -> &'b $t {
+                self
+            }
+        }
+    )*};
+}
+
+stored_as_they_are!(Triangle2D, Triangle2DFixed, Triangle3D64, CurvedTriangle);
 
 /// The tie rule of paper §3.4 (Direct3D's top-left rule written with derivatives):
 /// a sample on an edge (`E = 0`) belongs to the triangle whose edge function grows
@@ -180,6 +221,47 @@ pub trait Coverage {
     fn min_depth(&self) -> f32;
 }
 
+/// A reference reads as what it refers to (what [`Stored::bind`] gives the
+/// set-up triangles that are their own coverage).
+impl<C: Coverage> Coverage for &C {
+    #[inline(always)]
+    fn sample(&self, x: f32, y: f32) -> Option<f32> {
+        (**self).sample(x, y)
+    }
+    #[inline(always)]
+    fn sample8<L: Lanes>(&self, x0: f32, y: f32, active: u8) -> (u8, [f32; 8]) {
+        (**self).sample8::<L>(x0, y, active)
+    }
+    #[inline(always)]
+    fn sample_points8<L: Lanes>(&self, x: [f32; 8], y: [f32; 8], active: u8) -> (u8, [f32; 8]) {
+        (**self).sample_points8::<L>(x, y, active)
+    }
+    #[inline(always)]
+    fn covers8<L: Lanes>(&self, x: [f32; 8], y: [f32; 8]) -> u8 {
+        (**self).covers8::<L>(x, y)
+    }
+    #[inline(always)]
+    fn depth_inside8<L: Lanes>(&self, x: [f32; 8], y: [f32; 8]) -> (u8, [f32; 8]) {
+        (**self).depth_inside8::<L>(x, y)
+    }
+    #[inline(always)]
+    fn sample_run<L: Lanes>(&self, x0: f32, y: f32, n: u32, hit: impl FnMut(u32, f32)) {
+        (**self).sample_run::<L>(x0, y, n, hit);
+    }
+    #[inline(always)]
+    fn depth_inside(&self, x: f32, y: f32) -> Option<f32> {
+        (**self).depth_inside(x, y)
+    }
+    #[inline(always)]
+    fn classify_block(&self, x0: f32, y0: f32, x1: f32, y1: f32) -> BlockTest {
+        (**self).classify_block(x0, y0, x1, y1)
+    }
+    #[inline(always)]
+    fn min_depth(&self) -> f32 {
+        (**self).min_depth()
+    }
+}
+
 /// The scalar decisions of the `active` lanes as one lane mask and their
 /// depths (the default of the 8-sample methods).
 #[inline(always)]
@@ -220,6 +302,17 @@ pub trait EdgeWalk {
     /// its value and the tie rule, bit for bit as [`Coverage::sample`] and
     /// every lane form compute them.
     fn inside_edge_at(&self, i: usize, x: f32, y: f32) -> bool;
+}
+
+impl<E: EdgeWalk> EdgeWalk for &E {
+    #[inline(always)]
+    fn edge_line(&self, i: usize) -> [f64; 3] {
+        (**self).edge_line(i)
+    }
+    #[inline(always)]
+    fn inside_edge_at(&self, i: usize, x: f32, y: f32) -> bool {
+        (**self).inside_edge_at(i, x, y)
+    }
 }
 
 /// Edge functions linear in the image point (planar viewports): the parts from
