@@ -82,7 +82,7 @@ pub(crate) struct Traversal<'a, 't, T: Stored> {
     pub oracles: TraversalOracles,
     pub tile: &'t mut TileBuffer<'a>,
     pub setup: Setup<'a, T>,
-    /// What the view's set-up triangles share.
+    /// What the view's set-up triangles share (their vertices by BVH slot).
     pub shared: &'t T::Shared<'a>,
     /// The leaf triangles' screen boxes.
     pub boxes: &'t ScreenBoxes,
@@ -473,7 +473,7 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
             let id = scene.slot_triangles[slot as usize];
             raster_triangle(
                 self.tile,
-                &tri.bind(shared, id),
+                &tri.bind(shared, slot),
                 id,
                 clip,
                 self.oracles.samples,

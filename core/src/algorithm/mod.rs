@@ -119,7 +119,7 @@ pub(crate) fn run(
             render_frusta(scene, context, oracles, fb, stats, &(), Triangle3D64::setup)
         }
         Pipeline::Frusta(oracles) => {
-            let shared = setup3d::shared_3d(scene, view, false);
+            let shared = setup3d::slot_shared_3d(scene, view);
             render_frusta(
                 scene,
                 context,
@@ -151,7 +151,7 @@ pub(crate) fn run(
             context,
             fb,
             stats,
-            setup3d::shared_3d(scene, view, false),
+            setup3d::slot_shared_3d(scene, view),
             Triangle3D::setup_eight,
         ),
         Pipeline::Gpu => render_gpu(scene, context, fb, stats)?,

@@ -178,7 +178,7 @@ fn cast_band_on<L: Lanes, T: Stored>(
                     let Some(tri) = &setups.triangles[k as usize] else {
                         return false;
                     };
-                    let tri = tri.bind(&setups.shared, id);
+                    let tri = setups.bind(tri, k as usize, id);
                     let see_through = is_see_through(opacity, id);
                     let mut moved = false;
                     for half in 0..HALVES {
@@ -293,7 +293,7 @@ fn stored_masks<L: Lanes, T: Stored>(
                     continue;
                 };
                 tile.edge_evals[i] += pattern.coverage() as u32;
-                coverage_mask::<L, _>(&tri.bind(&setups.shared, id), pattern, x, y)
+                coverage_mask::<L, _>(&setups.bind(tri, slot as usize, id), pattern, x, y)
             }
         };
         tile.masks[s * pixels + i] = mask;

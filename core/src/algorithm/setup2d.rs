@@ -111,6 +111,7 @@ fn setup_pieces<T: Stored<Shared<'static> = ()>>(
         boxes,
         triangles,
         shared: (),
+        by_item: false,
     }
 }
 

@@ -37,6 +37,13 @@ pub(crate) fn shared_3d<'a>(
     Shared3D::of_mesh(view, homogeneous, &mesh.positions, &mesh.triangles)
 }
 
+/// What the view's [`Triangle3D`]s share, set up by the 3D setup, with their
+/// vertices by BVH slot: a ray caster or a BVH traversal knows its leaf
+/// triangles' slots, and finds their corners in one read.
+pub(crate) fn slot_shared_3d<'a>(scene: &'a PreparedScene, view: &'a View) -> Shared3D<'a> {
+    Shared3D::of_corners(view, false, &scene.slot_corners)
+}
+
 /// [`setup_3d`] in f64.
 pub(crate) fn setup_3d_f64<'a>(
     scene: &'a PreparedScene,
@@ -94,7 +101,8 @@ pub(crate) fn one_by_one<'a, T>(
 
 /// Every BVH slot's triangle set up by `setup` with its conservative screen
 /// box, in slot order (from the scene's slot-ordered copies of positions and
-/// vertex indices: memory read in order), eight slots at a time.
+/// vertex indices: memory read in order), eight slots at a time. `shared`
+/// finds the vertices by slot ([`slot_shared_3d`] for a [`Triangle3D`]).
 pub(crate) fn setup_slots<'a, T: Stored>(
     scene: &'a PreparedScene,
     view: &'a View,
@@ -115,7 +123,7 @@ pub(crate) fn setup_slots<'a, T: Stored>(
         let rects = rects_of(&boxes, &mut eight, p.len(), view, span);
         paired(rects, lanes_of(ids), setup(&eight, view))
     });
-    flattened(eights.unzip(), scene.slot_triangles.len(), shared)
+    flattened(eights.unzip(), scene.slot_triangles.len(), (shared, true))
 }
 
 /// Eight lanes' boxes (with the triangles' ids) and set-up triangles,
@@ -136,11 +144,12 @@ fn paired<T>(
     (boxes, triangles)
 }
 
-/// The first `len` items of chunks of eight, sharing `shared`.
+/// The first `len` items of chunks of eight, sharing `shared` (its
+/// vertices by item, or by triangle id).
 fn flattened<'a, T: Stored>(
     (boxes, triangles): (Vec<[ItemBox; 8]>, Vec<[Option<T>; 8]>),
     len: usize,
-    shared: T::Shared<'a>,
+    (shared, by_item): (T::Shared<'a>, bool),
 ) -> Setups<'a, T> {
     let (mut boxes, mut triangles) = (boxes.into_flattened(), triangles.into_flattened());
     boxes.truncate(len);
@@ -149,6 +158,7 @@ fn flattened<'a, T: Stored>(
         boxes,
         triangles,
         shared,
+        by_item,
     }
 }
 
@@ -207,5 +217,5 @@ fn setup_visible<'a, T: Stored>(
         let rects = rects_of(&boxes, &mut eight, ids.len(), view, span);
         paired(rects, lanes_of(ids), setup(&eight, view))
     });
-    flattened(eights.unzip(), scene.drawable.len(), shared)
+    flattened(eights.unzip(), scene.drawable.len(), (shared, false))
 }

@@ -23,6 +23,8 @@
 //! is then decided exactly — consistently across the whole mesh — while almost
 //! all of them take the f32 path (samples within ~10⁻⁴ pixel of an edge do not).
 
+use std::num::NonZeroU32;
+
 use glam::{DVec3, Vec3};
 
 use super::exact::{self, Expansion};
@@ -49,8 +51,9 @@ pub(crate) const EPS: f32 = f32::EPSILON * 0.5;
 /// as `Coverage` bound to it ([`Triangle3D::bind`]). Of `N·d` and the
 /// volume `|D|` one is constant on the image — `|D|` in perspective, `N·d_p`
 /// in parallel projection — and is kept as one number; each edge's error
-/// tolerance is kept rounded up to a power of two (a wider tolerance only
-/// sends more samples to the exact decision, which gives the same answer).
+/// tolerance is kept rounded up to two significant bits (a wider tolerance
+/// only sends more samples to the exact decision, which gives the same
+/// answer), the three in one word with the orientation ([`Tolerances`]).
 /// So a record is 64 bytes, aligned to a line, where it was 112: a ray or a
 /// tile reads one line per triangle, and setup writes 40% less.
 ///
@@ -75,40 +78,61 @@ pub struct Triangle3D {
     pub(super) w_range: [f32; 2],
     /// Per edge: a certified bound on how far [`Triangle3D::edge_values`] can be
     /// from the exact edge function anywhere on the image, within which the
-    /// exact sign decides; rounded up to a power of two ([`Tolerance`]).
-    pub(super) tolerance: [Tolerance; 3],
-    /// The edges were negated to make the inside positive.
-    pub(super) negated: bool,
+    /// exact sign decides; and whether the edges were negated to make the
+    /// inside positive.
+    pub(super) tolerance: Tolerances,
 }
 
 const _: () = assert!(size_of::<Triangle3D>() == 64);
 const _: () = assert!(size_of::<Option<Triangle3D>>() == 64);
 
-/// A non-negative f32 bound rounded up to a power of two (or zero), kept as
-/// its exponent bits: one byte.
+/// A triangle's three edge tolerances and its orientation in one word: each
+/// tolerance rounded up to a float of the f32 exponent and two mantissa bits
+/// (at most 25% wider, 10 bits), bit 30 set when the edges were negated, and
+/// bit 31 always set, so that `Option<Triangle3D>` takes no more room.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct Tolerance(u8);
+pub(crate) struct Tolerances(NonZeroU32);
 
-impl Tolerance {
-    /// The least power of two at or above `t` (`t` finite and `≥ 0`; zero
-    /// stays zero; beyond the largest finite power it is infinite).
+/// The f32 bits a kept tolerance drops: all but the exponent and the first
+/// two mantissa bits.
+const DROPPED: u32 = 21;
+
+/// The bit of [`Tolerances`] that is always set.
+const ALWAYS_SET: NonZeroU32 = NonZeroU32::new(1 << 31).unwrap();
+
+impl Tolerances {
+    /// Tolerances `t` (finite, `≥ 0`) of edges negated or not. Each is kept
+    /// as the least 10-bit float at or above it (zero stays zero; beyond the
+    /// largest such finite float it is infinite).
     #[inline(always)]
-    pub(super) fn above(t: f32) -> Tolerance {
-        let bits = t.to_bits() & 0x7fff_ffff;
-        let exponent = (bits >> 23) + u32::from(bits & 0x7f_ffff != 0);
-        Tolerance(exponent.min(255) as u8)
+    pub(super) fn new(t: [f32; 3], negated: bool) -> Tolerances {
+        let kept = |t: f32| {
+            let bits = t.to_bits() & 0x7fff_ffff;
+            let up = (bits >> DROPPED) + u32::from(bits & ((1 << DROPPED) - 1) != 0);
+            up.min(f32::INFINITY.to_bits() >> DROPPED)
+        };
+        let word = kept(t[0]) | kept(t[1]) << 10 | kept(t[2]) << 20 | u32::from(negated) << 30;
+        Tolerances(ALWAYS_SET | word)
     }
 
-    /// The bound.
+    /// Edge `k`'s tolerance.
     #[inline(always)]
-    pub(crate) fn get(self) -> f32 {
-        f32::from_bits(u32::from(self.0) << 23)
+    pub(crate) fn get(self, k: usize) -> f32 {
+        f32::from_bits((self.0.get() >> (10 * k) & 0x3ff) << DROPPED)
+    }
+
+    /// Were the edges negated to make the inside positive?
+    #[inline(always)]
+    pub(crate) fn negated(self) -> bool {
+        self.0.get() >> 30 & 1 == 1
     }
 }
 
 /// What every [`Triangle3D`] of one view shares: the view (`near`, the
-/// sample generator), which setup made them, and the scene's vertices by
-/// triangle id, from which the rare exact decisions recompute the edges.
+/// sample generator), which setup made them, and the scene's vertices by a
+/// key per triangle (its id in a mesh, or its index in a list of corners
+/// such as the BVH's slot-ordered ones), from which the rare exact
+/// decisions recompute the edges.
 #[derive(Clone, Copy, Debug)]
 pub struct Shared3D<'a> {
     view: &'a View,
@@ -119,15 +143,15 @@ pub struct Shared3D<'a> {
     corners: Corners<'a>,
 }
 
-/// Where a view's triangles' vertices are, by triangle id.
+/// Where a view's triangles' vertices are, by key.
 #[derive(Clone, Copy, Debug)]
 enum Corners<'a> {
-    /// A mesh: vertex positions and each triangle's three indices.
+    /// A mesh: vertex positions and each triangle's three indices (key: the id).
     Indexed {
         positions: &'a [Vec3],
         triangles: &'a [[u32; 3]],
     },
-    /// Each triangle's three corners.
+    /// Each triangle's three corners (key: the index).
     Listed(&'a [[Vec3; 3]]),
 }
 
@@ -172,26 +196,26 @@ impl<'a> Shared3D<'a> {
         }
     }
 
-    /// Triangle `id`'s corners as its setup read them.
-    fn corners(&self, id: u32) -> [Vec3; 3] {
+    /// The corners of the triangle of `key`, as its setup read them.
+    fn corners(&self, key: u32) -> [Vec3; 3] {
         match self.corners {
             Corners::Indexed {
                 positions,
                 triangles,
-            } => triangles[id as usize].map(|v| positions[v as usize]),
-            Corners::Listed(corners) => corners[id as usize],
+            } => triangles[key as usize].map(|v| positions[v as usize]),
+            Corners::Listed(corners) => corners[key as usize],
         }
     }
 }
 
 /// A [`Triangle3D`] read with what its view shares, as every coverage loop
-/// sees it ([`Coverage`]): the record, the shared data and the triangle's id
-/// (for the exact decisions), three words in registers.
+/// sees it ([`Coverage`]): the record, the shared data and the triangle's
+/// key there (for the exact decisions), three words in registers.
 #[derive(Clone, Copy, Debug)]
 pub struct Bound3D<'a> {
     t: &'a Triangle3D,
     shared: &'a Shared3D<'a>,
-    id: u32,
+    key: u32,
 }
 
 /// Which exact edge functions a [`Triangle3D`] stands for.
@@ -437,19 +461,18 @@ impl Triangle3D {
             varying,
             constant,
             w_range,
-            tolerance: tolerance.map(Tolerance::above),
-            negated,
+            tolerance: Tolerances::new(tolerance, negated),
         })
     }
 
-    /// This triangle (triangle `id` of the view `shared` describes) read as
+    /// This triangle, of `key` in the view `shared` describes, read as
     /// `Coverage`.
     #[inline(always)]
-    pub fn bind<'s>(&'s self, shared: &'s Shared3D<'s>, id: u32) -> Bound3D<'s> {
+    pub fn bind<'s>(&'s self, shared: &'s Shared3D<'s>, key: u32) -> Bound3D<'s> {
         Bound3D {
             t: self,
             shared,
-            id,
+            key,
         }
     }
 
@@ -476,7 +499,7 @@ impl Triangle3D {
             let (b, c) = (self.b[i], self.c[i]);
             flags |= u32::from(b > 0.0 || (b == 0.0 && c > 0.0)) << i;
         }
-        let [t0, t1, t2] = self.tolerance.map(Tolerance::get);
+        let [t0, t1, t2] = [0, 1, 2].map(|k| self.tolerance.get(k));
         let constant = [self.constant, 0.0, 0.0];
         let (nd, volume) = if parallel {
             (constant, self.varying)
@@ -501,7 +524,7 @@ impl Bound3D<'_> {
     #[inline(always)]
     fn inside(&self, e: [f32; 3], x: f32, y: f32) -> bool {
         (0..3).all(|i| {
-            let tolerance = self.t.tolerance[i].get();
+            let tolerance = self.t.tolerance.get(i);
             if e[i] > tolerance {
                 true
             } else if e[i] < -tolerance {
@@ -517,9 +540,9 @@ impl Bound3D<'_> {
     fn exact(&self) -> ExactEdges<'_> {
         ExactEdges {
             form: self.shared.form,
-            vertices: self.shared.corners(self.id),
+            vertices: self.shared.corners(self.key),
             view: self.shared.view,
-            negated: self.t.negated,
+            negated: self.t.tolerance.negated(),
         }
     }
 
@@ -751,7 +774,7 @@ impl Bound3D<'_> {
         let (mut certain_in, mut certain_out) = (active, !active);
         for k in 0..3 {
             let e = Self::linear_lanes([t.a[k], t.b[k], t.c[k]], x, y);
-            let tolerance = t.tolerance[k].get();
+            let tolerance = t.tolerance.get(k);
             certain_in &= e.gt(L::splat(tolerance));
             certain_out |= e.lt(L::splat(-tolerance));
         }
@@ -817,7 +840,7 @@ impl Coverage for Bound3D<'_> {
                 hi[k] = hi[k].max(e[k]);
             }
         }
-        let t = self.t.tolerance.map(Tolerance::get);
+        let t = [0, 1, 2].map(|k| self.t.tolerance.get(k));
         if (0..3).any(|k| hi[k] < -t[k]) {
             BlockTest::Outside
         } else if (0..3).all(|k| lo[k] > 3.0 * t[k]) {
@@ -894,40 +917,42 @@ mod tests {
     #[cfg(target_arch = "x86_64")]
     use crate::edge::lanes_test::lanes_agree_avx2;
 
-    /// A tolerance is kept as the least power of two at or above it: never
-    /// below it (a narrower bound would trust uncertain f32 signs), less
-    /// than twice it, zero as zero, subnormals and the largest values too.
+    /// A tolerance is kept as the least 10-bit float at or above it: never
+    /// below it (a narrower bound would trust uncertain f32 signs), at most
+    /// a quarter of its leading power of two above it, zero as zero,
+    /// subnormals and the largest values too; each edge's apart from the
+    /// others' and from the orientation.
     #[test]
-    fn tolerances_round_up_to_the_next_power_of_two() {
+    fn tolerances_round_up_to_two_mantissa_bits() {
         let mut rng = fastrand::Rng::with_seed(5);
         let mut cases = vec![
             0.0,
             f32::from_bits(1),
             f32::MIN_POSITIVE,
             1.0,
-            1.5,
+            1.3,
             3.0e-7,
-            2e38,
+            3e38,
         ];
         cases.extend((0..10_000).map(|_| f32::from_bits(rng.u32(0..0x7f80_0000))));
-        for &t in &cases {
-            let kept = Tolerance::above(t).get();
+        let largest = f32::from_bits(0x3fb << DROPPED);
+        for (n, &t) in cases.iter().enumerate() {
+            let others = [cases[(n + 1) % cases.len()], cases[(n + 2) % cases.len()]];
+            let negated = n % 3 == 0;
+            let word = Tolerances::new([others[0], t, others[1]], negated);
+            let kept = word.get(1);
             assert!(kept >= t, "{t:e} kept as {kept:e}");
-            assert_eq!(
-                kept.to_bits() & 0x7f_ffff,
-                0,
-                "{kept:e} is not a power of two"
-            );
-            if t == 0.0 {
-                assert_eq!(kept, 0.0);
-            } else if t <= 2f32.powi(127) {
-                assert!(
-                    kept < 2.0 * t || kept == f32::MIN_POSITIVE,
-                    "{t:e} kept as {kept:e}"
-                );
-            } else {
+            assert_eq!(kept.to_bits() & ((1 << DROPPED) - 1), 0, "{kept:e}");
+            if t > largest {
                 assert_eq!(kept, f32::INFINITY, "{t:e}");
+            } else if t >= f32::MIN_POSITIVE {
+                assert!(kept <= t * 1.25, "{t:e} kept as {kept:e}");
+            } else {
+                assert!(kept - t <= 2f32.powi(-128), "{t:e} kept as {kept:e}");
             }
+            let alone = others.map(|o| Tolerances::new([o; 3], false).get(0));
+            assert_eq!([word.get(0), word.get(2)], alone);
+            assert_eq!(word.negated(), negated);
         }
         assert_eq!(cases.len(), 10_007);
     }

@@ -13,7 +13,7 @@
 use glam::Vec3;
 
 use super::EightTriangles;
-use super::edge3d::{EPS, HomogeneousVertex, SCALE_ABOVE, Tolerance, Triangle3D, image_extent};
+use super::edge3d::{EPS, HomogeneousVertex, SCALE_ABOVE, Tolerances, Triangle3D, image_extent};
 use super::homogeneous::setup_homogeneous_from;
 use crate::camera::View;
 use crate::simd::{self, Lanes};
@@ -121,8 +121,10 @@ fn assembled(
             varying: [s.nd[0][l], s.nd[1][l], s.nd[2][l]],
             constant: s.volume[l],
             w_range: [w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2])],
-            tolerance: [0, 1, 2].map(|k| Tolerance::above(s.tolerance[k][l])),
-            negated: s.negated >> l & 1 == 1,
+            tolerance: Tolerances::new(
+                [0, 1, 2].map(|k| s.tolerance[k][l]),
+                s.negated >> l & 1 == 1,
+            ),
         });
     }
     out

@@ -92,16 +92,18 @@ pub(crate) trait Stored: Send + Sync {
     type Bound<'b>: Coverage
     where
         Self: 'b;
-    /// Triangle `id`, set up for the view `shared` describes, as [`Coverage`].
-    fn bind<'b, 's: 'b>(&'b self, shared: &'b Self::Shared<'s>, id: u32) -> Self::Bound<'b>;
+    /// The triangle, set up for the view `shared` describes, where it is
+    /// `key` (its id, or its index in the corners `shared` lists), as
+    /// [`Coverage`].
+    fn bind<'b, 's: 'b>(&'b self, shared: &'b Self::Shared<'s>, key: u32) -> Self::Bound<'b>;
 }
 
 impl Stored for Triangle3D {
     type Shared<'s> = Shared3D<'s>;
     type Bound<'b> = Bound3D<'b>;
     #[inline(always)]
-    fn bind<'b, 's: 'b>(&'b self, shared: &'b Shared3D<'s>, id: u32) -> Bound3D<'b> {
-        Triangle3D::bind(self, shared, id)
+    fn bind<'b, 's: 'b>(&'b self, shared: &'b Shared3D<'s>, key: u32) -> Bound3D<'b> {
+        Triangle3D::bind(self, shared, key)
     }
 }
 
