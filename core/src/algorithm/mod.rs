@@ -68,25 +68,18 @@ pub(crate) fn run(
             // each triangle rasterized by the box or hierarchy of `binning`,
             // or (`spans`, straight edges) by the sweep line of `scanline`.
             macro_rules! tiles {
-                ($items:expr) => {
-                    timed_tiles(
-                        &$items,
-                        fb,
-                        context,
-                        stats,
-                        start,
-                        |tile, tri, id, clip, n| raster_triangle(tile, tri, id, clip, samples, n),
-                    )
-                };
                 ($items:expr, spans) => {
-                    timed_tiles(
-                        &$items,
-                        fb,
-                        context,
-                        stats,
-                        start,
-                        |tile, tri, id, clip, n| raster_spans(tile, tri, id, clip, n),
-                    )
+                    tiles!($items, |tile, tri, id, clip, n| raster_spans(
+                        tile, tri, id, clip, n
+                    ))
+                };
+                ($items:expr) => {
+                    tiles!($items, |tile, tri, id, clip, n| {
+                        raster_triangle(tile, tri, id, clip, samples, n)
+                    })
+                };
+                ($items:expr, $kernel:expr) => {
+                    timed_tiles(&$items, fb, context, stats, start, $kernel)
                 };
             }
             let fixed = precision == Precision::Fixed;
