@@ -53,7 +53,7 @@ pub(crate) const EPS: f32 = f32::EPSILON * 0.5;
 /// in parallel projection — and is kept as one number; each edge's error
 /// tolerance is kept rounded up to two significant bits (a wider tolerance
 /// only sends more samples to the exact decision, which gives the same
-/// answer), the three in one word with the orientation ([`Tolerances`]).
+/// answer), the three in one word with the orientation (`Tolerances`).
 /// So a record is 64 bytes, aligned to a line, where it was 112: a ray or a
 /// tile reads one line per triangle, and setup writes 40% less.
 ///
