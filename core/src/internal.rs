@@ -46,7 +46,7 @@ fn covered_rows<L: Lanes>((triangles, shared): SetUp, width: u32, height: u32) -
     let mut covered = 0u64;
     for (id, t) in triangles.iter().enumerate() {
         let Some(t) = t else { continue };
-        let t = t.bind(shared, id as u32);
+        let t = t.bind(shared, id as u32, id as u32);
         for y in 0..height {
             t.sample_run::<L>(0.5, y as f32 + 0.5, width, |_, w| {
                 covered += u64::from(w > 0.0);

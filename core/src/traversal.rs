@@ -473,7 +473,7 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
             let id = scene.slot_triangles[slot as usize];
             raster_triangle(
                 self.tile,
-                &tri.bind(shared, slot),
+                &tri.bind(shared, slot, id),
                 id,
                 clip,
                 self.oracles.samples,

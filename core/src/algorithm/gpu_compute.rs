@@ -209,7 +209,7 @@ fn decide_unsure(
         };
         let homogeneous = kind == ComputeKind::Homogeneous;
         let shared = Shared3D::of_corners(view, homogeneous, &p);
-        let t = t.bind(&shared, 0);
+        let t = t.bind(&shared, 0, id);
         for &[_, i] in group {
             let i = i as usize;
             let pixel = i % pixels;

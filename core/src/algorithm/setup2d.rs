@@ -111,7 +111,6 @@ fn setup_pieces<T: Stored<Shared<'static> = ()>>(
         boxes,
         triangles,
         shared: (),
-        by_item: false,
     }
 }
 

@@ -123,7 +123,7 @@ pub(crate) fn setup_slots<'a, T: Stored>(
         let rects = rects_of(&boxes, &mut eight, p.len(), view, span);
         paired(rects, lanes_of(ids), setup(&eight, view))
     });
-    flattened(eights.unzip(), scene.slot_triangles.len(), (shared, true))
+    flattened(eights.unzip(), scene.slot_triangles.len(), shared)
 }
 
 /// Eight lanes' boxes (with the triangles' ids) and set-up triangles,
@@ -144,12 +144,11 @@ fn paired<T>(
     (boxes, triangles)
 }
 
-/// The first `len` items of chunks of eight, sharing `shared` (its
-/// vertices by item, or by triangle id).
+/// The first `len` items of chunks of eight, sharing `shared`.
 fn flattened<'a, T: Stored>(
     (boxes, triangles): (Vec<[ItemBox; 8]>, Vec<[Option<T>; 8]>),
     len: usize,
-    (shared, by_item): (T::Shared<'a>, bool),
+    shared: T::Shared<'a>,
 ) -> Setups<'a, T> {
     let (mut boxes, mut triangles) = (boxes.into_flattened(), triangles.into_flattened());
     boxes.truncate(len);
@@ -158,7 +157,6 @@ fn flattened<'a, T: Stored>(
         boxes,
         triangles,
         shared,
-        by_item,
     }
 }
 
@@ -217,5 +215,5 @@ fn setup_visible<'a, T: Stored>(
         let rects = rects_of(&boxes, &mut eight, ids.len(), view, span);
         paired(rects, lanes_of(ids), setup(&eight, view))
     });
-    flattened(eights.unzip(), scene.drawable.len(), (shared, false))
+    flattened(eights.unzip(), scene.drawable.len(), shared)
 }

@@ -99,9 +99,6 @@ pub(crate) struct Setups<'s, T: Stored> {
     pub boxes: Vec<ItemBox>,
     pub triangles: Vec<Option<T>>,
     pub shared: T::Shared<'s>,
-    /// `shared` finds a triangle's vertices by its item index (items in BVH
-    /// slot order, `shared` the slot-ordered corners), not by its id.
-    pub by_item: bool,
 }
 
 impl<T: Stored> Setups<'_, T> {
@@ -122,7 +119,7 @@ impl<T: Stored> Setups<'_, T> {
     /// `tri`, item `k` and triangle `id`, as coverage.
     #[inline(always)]
     pub(crate) fn bind<'b>(&'b self, tri: &'b T, k: usize, id: u32) -> T::Bound<'b> {
-        tri.bind(&self.shared, if self.by_item { k as u32 } else { id })
+        tri.bind(&self.shared, k as u32, id)
     }
 }
 

@@ -129,10 +129,10 @@ impl Tolerances {
 }
 
 /// What every [`Triangle3D`] of one view shares: the view (`near`, the
-/// sample generator), which setup made them, and the scene's vertices by a
-/// key per triangle (its id in a mesh, or its index in a list of corners
-/// such as the BVH's slot-ordered ones), from which the rare exact
-/// decisions recompute the edges.
+/// sample generator), which setup made them, and the triangles' vertices —
+/// by id in a mesh, or by item in a list of corners (the BVH's slot-ordered
+/// ones for a setup in slot order) — from which the rare exact decisions
+/// recompute the edges.
 #[derive(Clone, Copy, Debug)]
 pub struct Shared3D<'a> {
     view: &'a View,
@@ -143,15 +143,15 @@ pub struct Shared3D<'a> {
     corners: Corners<'a>,
 }
 
-/// Where a view's triangles' vertices are, by key.
+/// Where a view's triangles' vertices are.
 #[derive(Clone, Copy, Debug)]
 enum Corners<'a> {
-    /// A mesh: vertex positions and each triangle's three indices (key: the id).
+    /// A mesh: vertex positions and each triangle's three indices, by id.
     Indexed {
         positions: &'a [Vec3],
         triangles: &'a [[u32; 3]],
     },
-    /// Each triangle's three corners (key: the index).
+    /// Each item's three corners.
     Listed(&'a [[Vec3; 3]]),
 }
 
@@ -174,7 +174,7 @@ impl<'a> Shared3D<'a> {
         )
     }
 
-    /// Triangles with these corners, by index, set up for `view` by
+    /// Triangles with these corners, by item, set up for `view` by
     /// [`Triangle3D::setup`] or (`homogeneous`) the homogeneous setup.
     pub fn of_corners(view: &'a View, homogeneous: bool, corners: &'a [[Vec3; 3]]) -> Shared3D<'a> {
         Self::new(view, homogeneous, Corners::Listed(corners))
@@ -196,26 +196,28 @@ impl<'a> Shared3D<'a> {
         }
     }
 
-    /// The corners of the triangle of `key`, as its setup read them.
-    fn corners(&self, key: u32) -> [Vec3; 3] {
+    /// The corners of triangle `id`, item `item`, as its setup read them.
+    fn corners(&self, item: u32, id: u32) -> [Vec3; 3] {
         match self.corners {
             Corners::Indexed {
                 positions,
                 triangles,
-            } => triangles[key as usize].map(|v| positions[v as usize]),
-            Corners::Listed(corners) => corners[key as usize],
+            } => triangles[id as usize].map(|v| positions[v as usize]),
+            Corners::Listed(corners) => corners[item as usize],
         }
     }
 }
 
 /// A [`Triangle3D`] read with what its view shares, as every coverage loop
-/// sees it ([`Coverage`]): the record, the shared data and the triangle's
-/// key there (for the exact decisions), three words in registers.
+/// sees it ([`Coverage`]): the record, the shared data, and the triangle's
+/// item and id (by which the exact decisions find its corners), three words
+/// in registers.
 #[derive(Clone, Copy, Debug)]
 pub struct Bound3D<'a> {
     t: &'a Triangle3D,
     shared: &'a Shared3D<'a>,
-    key: u32,
+    item: u32,
+    id: u32,
 }
 
 /// Which exact edge functions a [`Triangle3D`] stands for.
@@ -465,14 +467,15 @@ impl Triangle3D {
         })
     }
 
-    /// This triangle, of `key` in the view `shared` describes, read as
-    /// `Coverage`.
+    /// This triangle, triangle `id` and item `item` of the setup for the
+    /// view `shared` describes, read as `Coverage`.
     #[inline(always)]
-    pub fn bind<'s>(&'s self, shared: &'s Shared3D<'s>, key: u32) -> Bound3D<'s> {
+    pub fn bind<'s>(&'s self, shared: &'s Shared3D<'s>, item: u32, id: u32) -> Bound3D<'s> {
         Bound3D {
             t: self,
             shared,
-            key,
+            item,
+            id,
         }
     }
 
@@ -540,7 +543,7 @@ impl Bound3D<'_> {
     fn exact(&self) -> ExactEdges<'_> {
         ExactEdges {
             form: self.shared.form,
-            vertices: self.shared.corners(self.key),
+            vertices: self.shared.corners(self.item, self.id),
             view: self.shared.view,
             negated: self.t.tolerance.negated(),
         }
@@ -993,7 +996,7 @@ mod tests {
             };
             let corners = [p];
             let shared = Shared3D::of_corners(&view, false, &corners);
-            let t = t.bind(&shared, 0);
+            let t = t.bind(&shared, 0, 0);
             // Every lane, or a different part of them per triangle.
             let active = if n % 2 == 0 {
                 0xff

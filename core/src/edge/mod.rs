@@ -92,18 +92,23 @@ pub(crate) trait Stored: Send + Sync {
     type Bound<'b>: Coverage
     where
         Self: 'b;
-    /// The triangle, set up for the view `shared` describes, where it is
-    /// `key` (its id, or its index in the corners `shared` lists), as
-    /// [`Coverage`].
-    fn bind<'b, 's: 'b>(&'b self, shared: &'b Self::Shared<'s>, key: u32) -> Self::Bound<'b>;
+    /// Triangle `id`, item `item` of the setup that made it for the view
+    /// `shared` describes, as [`Coverage`] (`shared` says which of the two
+    /// finds its vertices).
+    fn bind<'b, 's: 'b>(
+        &'b self,
+        shared: &'b Self::Shared<'s>,
+        item: u32,
+        id: u32,
+    ) -> Self::Bound<'b>;
 }
 
 impl Stored for Triangle3D {
     type Shared<'s> = Shared3D<'s>;
     type Bound<'b> = Bound3D<'b>;
     #[inline(always)]
-    fn bind<'b, 's: 'b>(&'b self, shared: &'b Shared3D<'s>, key: u32) -> Bound3D<'b> {
-        Triangle3D::bind(self, shared, key)
+    fn bind<'b, 's: 'b>(&'b self, shared: &'b Shared3D<'s>, item: u32, id: u32) -> Bound3D<'b> {
+        Triangle3D::bind(self, shared, item, id)
     }
 }
 
@@ -114,7 +119,7 @@ macro_rules! stored_as_they_are {
             type Shared<'s> = ();
             type Bound<'b> = &'b $t;
             #[inline(always)]
-            fn bind<'b, 's: 'b>(&'b self, _: &'b (), _: u32) -> &'b $t {
+            fn bind<'b, 's: 'b>(&'b self, _: &'b (), _: u32, _: u32) -> &'b $t {
                 self
             }
         }
