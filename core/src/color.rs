@@ -25,11 +25,12 @@ fn encode_srgb_formula(v: f32) -> u8 {
 const SRGB_BUCKETS: usize = 4096;
 
 /// [`encode_srgb_formula`] as tables: the first byte of each of
-/// [`SRGB_BUCKETS`] equal buckets, and per byte the smallest linear value
-/// that encodes to it (found by bisection over `f32` bit patterns, which
-/// order non-negative values), with `+∞` after the last: no byte past 255.
+/// [`SRGB_BUCKETS`] equal buckets (and of `1.0`, past the last), and per byte
+/// the smallest linear value that encodes to it (found by bisection over
+/// `f32` bit patterns, which order non-negative values), with `+∞` after the
+/// last: no byte past 255.
 struct SrgbTable {
-    bucket_start: Vec<u8>,
+    bucket_start: [u8; SRGB_BUCKETS + 1],
     thresholds: [f32; 257],
 }
 
@@ -50,9 +51,8 @@ fn srgb_table() -> &'static SrgbTable {
             }
             *t = f32::from_bits(lo);
         }
-        let bucket_start = (0..=SRGB_BUCKETS)
-            .map(|i| encode_srgb_formula(i as f32 / SRGB_BUCKETS as f32))
-            .collect();
+        let bucket_start =
+            std::array::from_fn(|i| encode_srgb_formula(i as f32 / SRGB_BUCKETS as f32));
         SrgbTable {
             bucket_start,
             thresholds,
@@ -60,28 +60,33 @@ fn srgb_table() -> &'static SrgbTable {
     })
 }
 
+impl SrgbTable {
+    /// [`encode_srgb`] without a branch for its special values: `v ≥ 1`
+    /// (`+∞` too) is read as `1`, whose bucket starts at 255; NaN and `v ≤ 0`
+    /// land in bucket 0 (the float-to-integer cast saturates, NaN to 0) and
+    /// never reach `thresholds[1] > 0`.
+    #[inline(always)]
+    fn encode(&self, v: f32) -> u8 {
+        let v = if v >= 1.0 { 1.0 } else { v };
+        // Exact: scaling by a power of two does not round.
+        let bucket = ((v * SRGB_BUCKETS as f32) as usize).min(SRGB_BUCKETS);
+        let mut b = self.bucket_start[bucket];
+        // A bucket is narrower than a byte's step almost everywhere: the first
+        // step without a branch, a second in the loop's rare turn.
+        b += u8::from(v >= self.thresholds[usize::from(b) + 1]);
+        while v >= self.thresholds[usize::from(b) + 1] {
+            b += 1;
+        }
+        b
+    }
+}
+
 /// Linear [0, 1] → sRGB byte, exactly the transfer function (tested on
 /// every threshold and millions of values) without its `powf`: the bucket's
 /// first byte, then up past the thresholds `v` reaches (at most a step or two).
-#[inline]
-pub fn encode_srgb(v: f32) -> u8 {
-    // NaN and v ≤ 0 encode to 0; v ≥ 1 to 255.
-    if v.is_nan() || v <= 0.0 {
-        return 0;
-    }
-    if v >= 1.0 {
-        return 255;
-    }
-    let table = srgb_table();
-    // Exact: scaling by a power of two does not round.
-    let mut b = table.bucket_start[(v * SRGB_BUCKETS as f32) as usize];
-    // A bucket is narrower than a byte's step almost everywhere: the first
-    // step without a branch, a second in the loop's rare turn.
-    b += u8::from(v >= table.thresholds[usize::from(b) + 1]);
-    while v >= table.thresholds[usize::from(b) + 1] {
-        b += 1;
-    }
-    b
+#[cfg(test)]
+fn encode_srgb(v: f32) -> u8 {
+    srgb_table().encode(v)
 }
 
 /// sRGB byte → linear [0, 1].
@@ -103,7 +108,23 @@ pub fn linear_rgb(c: [u8; 4]) -> Vec3 {
 /// Linear RGB → opaque sRGB RGBA8.
 #[inline]
 pub fn encode_rgb(c: Vec3) -> [u8; 4] {
-    [encode_srgb(c.x), encode_srgb(c.y), encode_srgb(c.z), 255]
+    let table = srgb_table();
+    [table.encode(c.x), table.encode(c.y), table.encode(c.z), 255]
+}
+
+/// [`encode_rgb`] of eight colours given channel by channel (what lanes
+/// hold): one table lookup, then 24 independent encodes.
+#[inline]
+pub fn encode_rgb_eight([r, g, b]: &[[f32; 8]; 3]) -> [[u8; 4]; 8] {
+    let table = srgb_table();
+    std::array::from_fn(|l| {
+        [
+            table.encode(r[l]),
+            table.encode(g[l]),
+            table.encode(b[l]),
+            255,
+        ]
+    })
 }
 
 #[cfg(test)]
@@ -121,6 +142,13 @@ mod tests {
             2.0,
             f32::NAN,
             f32::INFINITY,
+            f32::NEG_INFINITY,
+            -f32::NAN,
+            f32::MAX,
+            f32::MIN_POSITIVE,
+            f32::from_bits(1),
+            1.0f32.next_down(),
+            1.0f32.next_up(),
             0.003_130_8,
         ];
         for &t in &table.thresholds[..256] {
@@ -131,14 +159,27 @@ mod tests {
         let mut rng = fastrand::Rng::with_seed(5);
         values.extend((0..2_000_000).map(|_| rng.f32()));
         values.extend((0..200_000).map(|_| rng.f32() * 0.01));
-        for v in values {
+        for v in &values {
             assert_eq!(
-                encode_srgb(v),
-                encode_srgb_formula(v),
+                encode_srgb(*v),
+                encode_srgb_formula(*v),
                 "{v} ({:#x})",
                 v.to_bits()
             );
         }
+        // Eight at a time, each channel from its own place in the list.
+        let mut groups = 0;
+        for chunk in values.chunks_exact(24) {
+            let channels: [[f32; 8]; 3] =
+                std::array::from_fn(|c| std::array::from_fn(|l| chunk[8 * c + l]));
+            let eight = encode_rgb_eight(&channels);
+            for (l, rgba) in eight.iter().enumerate() {
+                let c = Vec3::new(channels[0][l], channels[1][l], channels[2][l]);
+                assert_eq!(*rgba, encode_rgb(c), "{c}");
+            }
+            groups += 1;
+        }
+        assert_eq!(groups, values.len() / 24);
     }
 
     #[test]

@@ -28,7 +28,9 @@ use std::time::Instant;
 use glam::Vec3;
 
 use crate::camera::View;
-use crate::color::{BACKGROUND_COLOR, OUTSIDE_VIEWPORT_COLOR, encode_rgb, linear_rgb};
+use crate::color::{
+    BACKGROUND_COLOR, OUTSIDE_VIEWPORT_COLOR, encode_rgb, encode_rgb_eight, linear_rgb,
+};
 use crate::effects::EffectCounters;
 use crate::framebuffer::{
     BACKGROUND, Fragment, TileBuffer, TilePlanes, TileTotals, wins_depth_test,
@@ -328,29 +330,40 @@ fn shade_single_on<L: Lanes>(
         let colors = &mut *out.color[r];
         for c0 in (0..width).step_by(8) {
             let n = (width - c0).min(8);
-            let mut eight = EightSamples {
-                ids: [BACKGROUND; 8],
-                x: [0.0; 8],
-                y: y as f32 + oy,
-                lanes: 0,
-            };
-            for l in 0..n {
-                let id = ids[c0 + l];
-                eight.ids[l] = id;
-                eight.x[l] = (tile.x0 + (c0 + l) as u32) as f32 + ox;
-                if id != BACKGROUND && shader.shades_in_lanes(id) {
-                    eight.lanes |= 1 << l;
-                }
+            let mut ids8 = [BACKGROUND; 8];
+            ids8[..n].copy_from_slice(&ids[c0..c0 + n]);
+            let all = u8::MAX >> (8 - n);
+            let surface = (0..8).fold(0u8, |m, l| m | u8::from(ids8[l] != BACKGROUND) << l) & all;
+            let colors = &mut colors[c0..c0 + n];
+            if surface == 0 && view.sphere.is_none() {
+                // A planar view has a ray through every pixel.
+                colors.fill(BACKGROUND_COLOR);
+                continue;
             }
-            let (linear, done) = match eight.lanes {
-                0 => ([Vec3::ZERO; 8], 0),
-                _ => shader.shade_eight::<L>(&eight),
+            let eight = EightSamples {
+                lanes: shader.lanes_shaded(&ids8, surface),
+                ids: ids8,
+                x: (tile.x0 + c0 as u32) as f32,
+                ox,
+                y: y as f32 + oy,
+            };
+            let (encoded, done) = match eight.lanes {
+                0 => ([[0; 4]; 8], 0),
+                _ => {
+                    let (linear, done) = shader.shade_eight::<L>(&eight);
+                    (encode_rgb_eight(&linear), done)
+                }
             };
             totals.shading_samples += u64::from(done.count_ones());
-            for l in 0..n {
-                let (id, at) = (eight.ids[l], (eight.x[l], eight.y));
-                colors[c0 + l] = if done & (1 << l) != 0 {
-                    encode_rgb(linear[l])
+            if done == all {
+                colors.copy_from_slice(&encoded[..n]);
+                continue;
+            }
+            let xs = eight.lane_x::<L>().to_array();
+            for (l, color) in colors.iter_mut().enumerate() {
+                let (id, at) = (eight.ids[l], (xs[l], eight.y));
+                *color = if done & (1 << l) != 0 {
+                    encoded[l]
                 } else if id == BACKGROUND {
                     // Only non-planar viewports have pixels without a ray.
                     match view.sphere.is_some() && view.ray(at.0, at.1).is_none() {

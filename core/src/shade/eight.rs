@@ -118,14 +118,28 @@ fn finite<L: Lanes>(v: L) -> u8 {
     (v * zero).eq(zero)
 }
 
-/// Eight samples of one row: triangle ids, pixel positions and the lanes to shade.
+/// Eight samples of one row, at `(x + l) + ox` and `y` for lane `l`:
+/// triangle ids, positions and the lanes to shade.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct EightSamples {
     pub ids: [u32; 8],
-    pub x: [f32; 8],
+    /// The first lane's pixel column (an integer).
+    pub x: f32,
+    /// The sample's offset in its pixel.
+    pub ox: f32,
     pub y: f32,
     /// Lanes holding a triangle whose material [`Shader::shades_in_lanes`].
     pub lanes: u8,
+}
+
+impl EightSamples {
+    /// Each lane's x: its column, `x + l` (integers add exactly in f32),
+    /// plus the offset — what `column as f32 + ox` gives.
+    #[inline(always)]
+    pub(crate) fn lane_x<L: Lanes>(&self) -> L {
+        let steps = L::from_array(std::array::from_fn(|l| l as f32));
+        (L::splat(self.x) + steps) + L::splat(self.ox)
+    }
 }
 
 impl Shader<'_> {
@@ -135,11 +149,24 @@ impl Shader<'_> {
         self.lane_materials.get(self.material_of(id) as usize) == Some(&true)
     }
 
-    /// The linear colour [`Shader::shade`] gives each lane of `s`, and the
-    /// lanes it holds: those of `s.lanes` that met none of the scalar path's
-    /// special cases (see the module documentation).
+    /// Of the eight ids, bit per lane: those of `lanes` that [`Shader::shades_in_lanes`].
     #[inline(always)]
-    pub(crate) fn shade_eight<L: Lanes>(&self, s: &EightSamples) -> ([Vec3; 8], u8) {
+    pub(crate) fn lanes_shaded(&self, ids: &[u32; 8], lanes: u8) -> u8 {
+        if self.lane_materials == [true] {
+            // One material, shaded in lanes: no per-sample read.
+            return lanes;
+        }
+        (0..8)
+            .filter(|&l| lanes & (1 << l) != 0 && self.shades_in_lanes(ids[l]))
+            .fold(0, |m, l| m | 1 << l)
+    }
+
+    /// The linear colour [`Shader::shade`] gives each lane of `s`, channel
+    /// by channel (red, green, blue), and the lanes it holds: those of
+    /// `s.lanes` that met none of the scalar path's special cases (see the
+    /// module documentation).
+    #[inline(always)]
+    pub(crate) fn shade_eight<L: Lanes>(&self, s: &EightSamples) -> ([[f32; 8]; 3], u8) {
         let prepared = self.scene;
         let mesh = &prepared.scene.mesh;
         let interpolated = !mesh.normals.is_empty();
@@ -201,7 +228,7 @@ impl Shader<'_> {
 
         // 2. The ray through each sample (`View::origin`, `View::direction`).
         let view = self.view;
-        let (x, y) = (L::from_array(s.x), L::splat(s.y));
+        let (x, y) = (s.lane_x::<L>(), L::splat(s.y));
         let dir = along([view.d0, view.dx, view.dy], x, y);
         let origin = V3::splat(view.eye).add(along([view.o0, view.ox, view.oy], x, y));
 
@@ -269,6 +296,6 @@ impl Shader<'_> {
         let r = (base.x * ambient(lit.x) + emissive.x).to_array();
         let g = (base.y * ambient(lit.y) + emissive.y).to_array();
         let b = (base.z * ambient(lit.z) + emissive.z).to_array();
-        (std::array::from_fn(|l| Vec3::new(r[l], g[l], b[l])), done)
+        ([r, g, b], done)
     }
 }
