@@ -45,17 +45,17 @@ impl std::ops::AddAssign for CoverageHistogram {
 
 impl CoverageHistogram {
     pub fn of(coverage_writes: &[u32]) -> CoverageHistogram {
-        // Counted without a branch per pixel (the counts vectorize).
-        let (mut zero, mut one) = (0u32, 0u32);
         let mut h = CoverageHistogram::default();
+        // Counted without a branch per pixel, in u32 that cannot overflow
+        // (the counts vectorize).
         for chunk in coverage_writes.chunks(1 << 16) {
+            let (mut zero, mut one) = (0u32, 0u32);
             for &c in chunk {
                 zero += u32::from(c == 0);
                 one += u32::from(c == 1);
             }
             h.zero += u64::from(zero);
             h.one += u64::from(one);
-            (zero, one) = (0, 0);
         }
         h.many = coverage_writes.len() as u64 - h.zero - h.one;
         h
@@ -191,5 +191,30 @@ impl std::ops::AddAssign for RasterCounters {
         self.edge_steps += o.edge_steps;
         self.edge_tests_f64 += o.edge_tests_f64;
         self.edge_tests_exact += o.edge_tests_exact;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::CoverageHistogram;
+
+    #[test]
+    fn the_coverage_histogram_counts_zero_one_and_many_across_chunks() {
+        // Longer than one 2¹⁶ chunk, with a known count of each kind.
+        let writes: Vec<u32> = (0..200_003u32)
+            .map(|i| [0, 1, 1, 2, 7, u32::MAX][i as usize % 6])
+            .collect();
+        let expect = |kind: &[u32]| writes.iter().filter(|c| kind.contains(c)).count() as u64;
+        let h = CoverageHistogram::of(&writes);
+        assert_eq!(
+            h,
+            CoverageHistogram {
+                zero: expect(&[0]),
+                one: expect(&[1]),
+                many: expect(&[2, 7, u32::MAX]),
+            }
+        );
+        assert_eq!(h.zero + h.one + h.many, 200_003);
+        assert_eq!(CoverageHistogram::of(&[]), CoverageHistogram::default());
     }
 }
