@@ -333,7 +333,8 @@ fn shade_single_on<L: Lanes>(
             let mut ids8 = [BACKGROUND; 8];
             ids8[..n].copy_from_slice(&ids[c0..c0 + n]);
             let all = u8::MAX >> (8 - n);
-            let surface = (0..8).fold(0u8, |m, l| m | u8::from(ids8[l] != BACKGROUND) << l) & all;
+            // Lanes past the row's end hold BACKGROUND: no bit there.
+            let surface = (0..8).fold(0u8, |m, l| m | u8::from(ids8[l] != BACKGROUND) << l);
             let colors = &mut colors[c0..c0 + n];
             if surface == 0 && view.sphere.is_none() {
                 // A planar view has a ray through every pixel.

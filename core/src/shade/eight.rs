@@ -152,8 +152,7 @@ impl Shader<'_> {
     /// Of the eight ids, bit per lane: those of `lanes` that [`Shader::shades_in_lanes`].
     #[inline(always)]
     pub(crate) fn lanes_shaded(&self, ids: &[u32; 8], lanes: u8) -> u8 {
-        if self.lane_materials == [true] {
-            // One material, shaded in lanes: no per-sample read.
+        if self.all_in_lanes {
             return lanes;
         }
         (0..8)

@@ -57,6 +57,9 @@ pub struct Shader<'a> {
     /// Per material: are its samples shaded by [`Shader::shade_eight`]
     /// (a planar view, no texture, vertex colours, mirror or shadow ray)?
     lane_materials: Vec<bool>,
+    /// Every material's samples are shaded in lanes (`lane_materials` all
+    /// true and not empty): no per-sample material read decides it.
+    all_in_lanes: bool,
 }
 
 impl<'a> Shader<'a> {
@@ -92,6 +95,7 @@ impl<'a> Shader<'a> {
                 })
                 .collect(),
         };
+        let all_in_lanes = !lane_materials.is_empty() && lane_materials.iter().all(|&m| m);
         Shader {
             scene,
             view,
@@ -102,6 +106,7 @@ impl<'a> Shader<'a> {
             rays: Rays::new(scene),
             t_min: scene.bounds.radius().max(f32::MIN_POSITIVE) * SECONDARY_OFFSET,
             lane_materials,
+            all_in_lanes,
         }
     }
 
