@@ -272,6 +272,9 @@ pub(crate) struct TilePlanes<'f> {
 pub(crate) struct TileTotals {
     /// Coverage writes per stored sample: zero, one, many.
     pub histogram: CoverageHistogram,
+    /// Sample-against-triangle tests made in the tile, and the most at one pixel.
+    pub edge_evaluations: u64,
+    pub max_edge_evals: u32,
     /// Shading evaluations made.
     pub shading_samples: u64,
     /// What the tile's effect rays cost.

@@ -4,7 +4,6 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::algorithm;
@@ -125,15 +124,6 @@ pub fn render_cancellable(
     }
 
     let start = Instant::now();
-    (stats.edge_evaluations, stats.max_edge_evals_per_pixel) = fb
-        .edge_evals
-        .par_chunks(4096)
-        .map(|chunk| {
-            chunk.iter().fold((0u64, 0u32), |(sum, max), &e| {
-                (sum + u64::from(e), max.max(e))
-            })
-        })
-        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1.max(b.1)));
     let pixels = u64::from(request.width) * u64::from(request.height);
     stats.samples_per_pixel = request.aa.coverage_samples();
     stats.stored_samples_per_pixel = request.aa.stored_samples();

@@ -113,8 +113,10 @@ impl FragmentLayers {
 /// The resolve of `tile` into its place in the frame, `out`: each pixel's
 /// first stored sample (depth, triangle id), its counters summed over its
 /// samples and, with anti-aliasing, its sample digest; returns the tile's
-/// coverage histogram. Colours are [`shade_tile`]'s.
-fn resolve_tile(tile: &TileBuffer, out: &mut TilePlanes) -> CoverageHistogram {
+/// coverage histogram and edge evaluations (counted here, while the tile's
+/// buffers are in cache, not over the frame afterwards). Colours are
+/// [`shade_tile`]'s.
+fn resolve_tile(tile: &TileBuffer, out: &mut TilePlanes) -> TileTotals {
     let pattern = tile.pattern;
     let (stored, pixels) = (pattern.stored, tile.pixels);
     let width = (tile.x1 - tile.x0) as usize;
@@ -149,7 +151,16 @@ fn resolve_tile(tile: &TileBuffer, out: &mut TilePlanes) -> CoverageHistogram {
             }
         }
     }
-    CoverageHistogram::of(&tile.coverage_writes)
+    let (edge_evaluations, max_edge_evals) = (tile.edge_evals.iter())
+        .fold((0u64, 0u32), |(sum, max), &e| {
+            (sum + u64::from(e), max.max(e))
+        });
+    TileTotals {
+        histogram: CoverageHistogram::of(&tile.coverage_writes),
+        edge_evaluations,
+        max_edge_evals,
+        ..TileTotals::default()
+    }
 }
 
 /// A rendered tile into the frame: [`resolve_tile`], then [`shade_tile`];
@@ -161,10 +172,12 @@ pub(crate) fn finish_tile(
     out: &mut TilePlanes,
 ) -> (TileTotals, [f64; 2]) {
     let start = Instant::now();
-    let histogram = resolve_tile(tile, out);
+    let counted = resolve_tile(tile, out);
     let resolved = Instant::now();
     let totals = TileTotals {
-        histogram,
+        histogram: counted.histogram,
+        edge_evaluations: counted.edge_evaluations,
+        max_edge_evals: counted.max_edge_evals,
         ..shade_tile(tile, view, shader, out)
     };
     let seconds = [resolved - start, resolved.elapsed()].map(|d| d.as_secs_f64());

@@ -153,6 +153,8 @@ pub(crate) fn run(
     stats.time_ms.store += pass.store_ms;
     stats.counters = pass.counters;
     stats.coverage_histogram = pass.histogram;
+    stats.edge_evaluations = pass.edge_evaluations;
+    stats.max_edge_evals_per_pixel = pass.max_edge_evals;
     stats.shading_samples = pass.shading_samples;
     stats.effects = pass.effects.report(context.shader.plan(), &scene.scene);
     Ok(pass.trace)
@@ -386,6 +388,9 @@ impl<'a> TileContext<'a> {
 pub(crate) struct Pass {
     pub counters: RasterCounters,
     pub histogram: CoverageHistogram,
+    /// Sample-against-triangle tests over all tiles, and the most at one pixel.
+    pub edge_evaluations: u64,
+    pub max_edge_evals: u32,
     pub shading_samples: u64,
     pub effects: crate::effects::EffectCounters,
     /// Worker seconds rendering, resolving and shading, over all tiles.
@@ -417,6 +422,8 @@ impl Pass {
             self.counters.edge_tests_f64 += finished.precise[0];
             self.counters.edge_tests_exact += finished.precise[1];
             self.histogram += finished.totals.histogram;
+            self.edge_evaluations += finished.totals.edge_evaluations;
+            self.max_edge_evals = self.max_edge_evals.max(finished.totals.max_edge_evals);
             self.shading_samples += finished.totals.shading_samples;
             self.effects.add(&finished.totals.effects);
             for (sum, s) in self.seconds.iter_mut().zip(finished.seconds) {

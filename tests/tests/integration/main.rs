@@ -3,6 +3,7 @@
 mod aa;
 mod agreement;
 mod conformance;
+mod counters;
 mod effects;
 mod golden;
 mod gpu_compute;
