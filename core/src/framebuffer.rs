@@ -160,17 +160,24 @@ impl Framebuffer {
         for row in &mut rows {
             row.sort_unstable_by_key(|&t| rects[t].x0);
         }
+        // Each tile's rows, allocated once (an optional plane the render
+        // has not gets none).
+        let (digest, blended) = (!self.sample_digest.is_empty(), !self.blended.is_empty());
         let mut planes: Vec<TilePlanes> = rects
             .iter()
-            .map(|&rect| TilePlanes {
-                rect,
-                color: Vec::new(),
-                depth: Vec::new(),
-                triangle_id: Vec::new(),
-                edge_evals: Vec::new(),
-                coverage_writes: Vec::new(),
-                sample_digest: Vec::new(),
-                blended: Vec::new(),
+            .map(|&rect| {
+                let h = rect.height() as usize;
+                let optional = |present: bool| if present { h } else { 0 };
+                TilePlanes {
+                    rect,
+                    color: Vec::with_capacity(h),
+                    depth: Vec::with_capacity(h),
+                    triangle_id: Vec::with_capacity(h),
+                    edge_evals: Vec::with_capacity(h),
+                    coverage_writes: Vec::with_capacity(h),
+                    sample_digest: Vec::with_capacity(optional(digest)),
+                    blended: Vec::with_capacity(optional(blended)),
+                }
             })
             .collect();
         split_rows(&mut self.color, width, &rows, rects, &mut planes, |p| {
