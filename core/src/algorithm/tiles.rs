@@ -20,6 +20,9 @@ use crate::stats::RasterCounters;
 const TILE_WIDTH: u32 = 256;
 const TILE_HEIGHT: u32 = 16;
 
+/// How many items ahead of the one rasterized a tile fetches records.
+const PREFETCH_AHEAD: usize = 8;
+
 /// Items per run of the parallel binning.
 const BIN_RUN: usize = 1 << 14;
 
@@ -186,11 +189,14 @@ pub(crate) fn rasterize_tiled<T: Stored>(
             |cache, (t, planes)| {
                 context.run_tile(cache, planes, |tile| {
                     let mut counters = RasterCounters::default();
-                    let mut members = runs.iter().flat_map(|run| run.of(t)).peekable();
-                    while let Some(&k) = members.next() {
-                        // The next item's records are on their way while this
-                        // one is rasterized (they are far apart in memory).
-                        if let Some(&&next) = members.peek() {
+                    let members: Vec<u32> =
+                        runs.iter().flat_map(|run| run.of(t)).copied().collect();
+                    for (i, &k) in members.iter().enumerate() {
+                        // The records of an item a few places on are on their
+                        // way while this one is rasterized (they are far apart
+                        // in memory, and a small triangle takes less time than
+                        // a miss).
+                        if let Some(&next) = members.get(i + PREFETCH_AHEAD) {
                             simd::prefetch(&items.boxes[next as usize]);
                             simd::prefetch(&items.triangles[next as usize]);
                         }
