@@ -40,6 +40,9 @@ pub(crate) struct Hiz {
     cells: Vec<Cell>,
     rect: PixelRect,
     columns: u32,
+    /// Changes whenever a cell may have: what was read from the cells
+    /// under one version holds until it changes.
+    version: u64,
 }
 
 /// The mask bits of pixel columns `x0..x1` and rows `y0..y1` of a cell
@@ -73,6 +76,7 @@ impl Hiz {
             cells: Vec::new(),
             rect,
             columns: 0,
+            version: 0,
         };
         hiz.reset(rect);
         hiz
@@ -81,6 +85,7 @@ impl Hiz {
     /// Empty cells over the pixels of `rect` (the memory kept); the cells
     /// along its right and bottom edges with their bits beyond it set.
     pub fn reset(&mut self, rect: PixelRect) {
+        self.version += 1;
         self.rect = rect;
         let (width, height) = (rect.width(), rect.height());
         self.columns = width.div_ceil(HIZ_CELL);
@@ -165,6 +170,13 @@ impl Hiz {
         (farthest, nearest)
     }
 
+    /// The cells' version: [`Hiz::depths`] of a rectangle is the same
+    /// while it is.
+    #[inline]
+    pub fn version(&self) -> u64 {
+        self.version
+    }
+
     /// Is everything at depth `w` hidden over the pixels of `r`: every stored
     /// sample of them holds a depth, and in each cell they touch all held
     /// depths are nearer than `w`? (The depth test keeps the nearer sample, and
@@ -185,6 +197,7 @@ impl Hiz {
     /// just become covered, or when `r`'s depths fell below it (the farthest
     /// may have been one of them).
     pub fn update(&mut self, r: PixelRect, depth: &[f32], pixels: usize) {
+        self.version += 1;
         let [lx0, ly0, lx1, ly1] = self.local(r);
         for cy in cells(ly0, ly1) {
             for cx in cells(lx0, lx1) {
@@ -328,6 +341,36 @@ mod tests {
             f32::INFINITY,
             "the bottom rows are empty"
         );
+    }
+
+    /// What a frustum keeps of [`Hiz::depths`] is kept under a version:
+    /// every update and reset changes it, and what was read under the
+    /// current one is what a fresh read gives.
+    #[test]
+    fn the_version_changes_with_the_cells() {
+        let rect = PixelRect::new(0, 0, 16, 16);
+        let mut hiz = Hiz::new(rect);
+        let mut seen = vec![hiz.version()];
+        let mut depth = vec![f32::INFINITY; 256];
+        for (k, r) in [PixelRect::new(0, 0, 8, 8), PixelRect::new(4, 4, 16, 16)]
+            .into_iter()
+            .enumerate()
+        {
+            let (read, version) = (hiz.depths(rect), hiz.version());
+            for y in r.y0..r.y1 {
+                for x in r.x0..r.x1 {
+                    depth[(y * 16 + x) as usize] = 1.0 + k as f32;
+                }
+            }
+            hiz.update(r, &depth, 256);
+            assert_ne!(hiz.version(), version);
+            assert_ne!(hiz.depths(rect), read, "the update changed the depths");
+            seen.push(hiz.version());
+        }
+        hiz.reset(rect);
+        seen.push(hiz.version());
+        seen.dedup();
+        assert_eq!(seen.len(), 4, "{seen:?}");
     }
 
     /// With several stored samples a pixel is covered only when all are.

@@ -32,23 +32,17 @@ use crate::trace::{FrustumEvent, NodeOutcome};
 /// result may borrow both.
 pub(crate) type Setup<'a, T> = fn(&'a [Vec3; 3], &'a View) -> Option<T>;
 
-/// A leaf triangle as the frusta of one work item met it: its BVH slot
-/// (`u32::MAX`: none), its screen box (`None`: no sample on screen), and its
-/// setup once a frustum needed it (`Some(None)`: set up, but seen edge-on).
+/// A leaf triangle as the frusta of one work item met it: its screen box
+/// (`None`: no sample on screen), and its setup once a frustum needed it
+/// (`Some(None)`: set up, but seen edge-on).
 #[derive(Clone, Copy, Debug)]
 struct Leaf<T> {
-    slot: u32,
     rect: Option<PixelRect>,
     tri: Option<Option<T>>,
 }
 
-impl<T> Leaf<T> {
-    const EMPTY: Leaf<T> = Leaf {
-        slot: u32::MAX,
-        rect: None,
-        tri: None,
-    };
-}
+/// A [`LeafCache`] entry that holds no triangle.
+const NO_LEAF: u32 = u32::MAX;
 
 /// The leaf triangles the frusta of one work item reached last, by BVH
 /// slot: a triangle's box is made and its setup done once while it stays
@@ -58,9 +52,13 @@ impl<T> Leaf<T> {
 /// triangles and its neighbours' have consecutive slots, so they do not
 /// evict each other — and small enough to stay in cache beside the tile
 /// (a map of every triangle reached cost more than the setups it saved on
-/// a million small triangles). Kept by the worker, emptied per work item.
+/// a million small triangles). Kept by the worker, emptied per work item:
+/// only the slots, apart from the entries (4 bytes an entry to clear, not a
+/// set-up triangle's 90).
 #[derive(Debug)]
 pub(crate) struct LeafCache<T> {
+    /// Per entry, the BVH slot it holds ([`NO_LEAF`]: none).
+    slots: Vec<u32>,
     leaves: Vec<Leaf<T>>,
 }
 
@@ -70,7 +68,14 @@ const LEAF_CACHE: usize = 1024;
 impl<T: Copy> Default for LeafCache<T> {
     fn default() -> Self {
         LeafCache {
-            leaves: vec![Leaf::EMPTY; LEAF_CACHE],
+            slots: vec![NO_LEAF; LEAF_CACHE],
+            leaves: vec![
+                Leaf {
+                    rect: None,
+                    tri: None,
+                };
+                LEAF_CACHE
+            ],
         }
     }
 }
@@ -171,10 +176,15 @@ impl<L: Lanes> ChildTests<L> {
 
 /// A frustum: its pixels, the four side planes through their borders, and
 /// its centre ray — computed once when the frustum is made, not at every node
-/// it meets.
-#[derive(Clone, Copy, Debug)]
+/// it meets — and the hierarchical w-buffer's depths over its pixels, read
+/// again only when the buffer has changed (a 128² frustum spans 256 cells,
+/// and meets many nodes between two leaves).
+#[derive(Clone, Debug)]
 struct Frustum {
     rect: PixelRect,
+    /// [`Hiz::depths`](crate::hiz::Hiz::depths) of `rect` and the
+    /// [`Hiz::version`](crate::hiz::Hiz::version) it was read at.
+    depths: std::cell::Cell<Option<(u64, f32, f32)>>,
     /// Each side plane as `n·(p − eye) ≥ offset` (through the eye under
     /// perspective, parallel to the view axis under orthographic projection).
     planes: [(Vec3A, f32); 4],
@@ -213,6 +223,7 @@ impl Frustum {
         );
         Frustum {
             rect,
+            depths: std::cell::Cell::new(None),
             planes: planes.map(|(n, offset)| (Vec3A::from(n), offset)),
             centre: SlabRay::new(v.origin(cx, cy), v.direction(cx, cy)),
         }
@@ -230,7 +241,7 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
         (setup, shared, boxes): (Setup<'a, T>, &'t T::Shared<'a>, &'t ScreenBoxes),
         leaves: &'t mut LeafCache<T>,
     ) -> Self {
-        leaves.leaves.fill(Leaf::EMPTY);
+        leaves.slots.fill(NO_LEAF);
         Traversal {
             scene,
             view,
@@ -395,7 +406,15 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
     /// frustum, or over the pixels its screen box reaches in it when some
     /// other pixels of the frustum are still empty ([`crate::hiz`])?
     fn is_occluded(&self, f: &Frustum, b: &NodeBox) -> bool {
-        let (farthest, nearest) = self.tile.hiz.depths(f.rect);
+        let hiz = &self.tile.hiz;
+        let (farthest, nearest) = match f.depths.get() {
+            Some((version, farthest, nearest)) if version == hiz.version() => (farthest, nearest),
+            _ => {
+                let (farthest, nearest) = hiz.depths(f.rect);
+                f.depths.set(Some((hiz.version(), farthest, nearest)));
+                (farthest, nearest)
+            }
+        };
         if b.min_w > farthest {
             return true;
         }
@@ -445,10 +464,10 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
         for slot in start..start + count {
             // The slot-ordered copies: a leaf's triangles sit side by side.
             let p = &scene.slot_corners[slot as usize];
-            let leaf = &mut self.leaves.leaves[slot as usize % LEAF_CACHE];
-            if leaf.slot != slot {
+            let entry = slot as usize % LEAF_CACHE;
+            let leaf = &mut self.leaves.leaves[entry];
+            if std::mem::replace(&mut self.leaves.slots[entry], slot) != slot {
                 *leaf = Leaf {
-                    slot,
                     rect: boxes.rect(p, scene.slot_vertices[slot as usize], view, span),
                     tri: None,
                 };
