@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use super::setup3d::{self, SetupEight};
 use super::tiles::Setups;
-use super::{Pass, PixelRect, TileContext};
+use super::{Pass, PerWorker, PixelRect, TileContext};
 use crate::aa::SamplePattern;
 use crate::bvh::{PACKET, PacketRays};
 use crate::camera::View;
@@ -62,15 +62,15 @@ pub(crate) fn render_raycast<'a, T: Stored>(
     let start = Instant::now();
     let mut pass = Pass::default();
     let bands = fb.tile_rects(fb.width, BAND_ROWS);
+    let workers = PerWorker::new();
     let done: Vec<_> = pass
         .planes(fb, &bands)
         .into_par_iter()
-        .map_init(
-            || None,
-            |cache, planes| {
+        .map(|planes| {
+            workers.with(|cache| {
                 context.run_tile(cache, planes, |tile| cast_band(scene, view, &setups, tile))
-            },
-        )
+            })
+        })
         .collect();
     pass.add(done.into_iter().map(|finished| {
         stats.bvh_nodes_visited += finished.result;

@@ -5,7 +5,7 @@
 
 use rayon::prelude::*;
 
-use super::{Pass, PixelRect, TileContext};
+use super::{Pass, PerWorker, PixelRect, TileContext};
 use crate::edge::Stored;
 use crate::framebuffer::{Framebuffer, TileBuffer};
 use crate::simd;
@@ -179,14 +179,14 @@ pub(crate) fn rasterize_tiled<T: Stored>(
     // 2. Tiles in parallel, in input order within a tile, each resolved by
     // its worker (the samples never outlive their tile).
     let rects = fb.tile_rects(TILE_WIDTH, TILE_HEIGHT);
+    let workers = PerWorker::new();
     let mut pass = Pass::default();
     let done: Vec<_> = pass
         .planes(fb, &rects)
         .into_par_iter()
         .enumerate()
-        .map_init(
-            || None,
-            |cache, (t, planes)| {
+        .map(|(t, planes)| {
+            workers.with(|cache| {
                 context.run_tile(cache, planes, |tile| {
                     let mut counters = RasterCounters::default();
                     let members: Vec<u32> =
@@ -211,8 +211,8 @@ pub(crate) fn rasterize_tiled<T: Stored>(
                     }
                     counters
                 })
-            },
-        )
+            })
+        })
         .collect();
     pass.add(done);
     pass
