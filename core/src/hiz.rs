@@ -344,8 +344,8 @@ mod tests {
     }
 
     /// What a frustum keeps of [`Hiz::depths`] is kept under a version:
-    /// every update and reset changes it, and what was read under the
-    /// current one is what a fresh read gives.
+    /// every update and reset changes it (here each update also changes the
+    /// depths, so a frustum holding the old ones must read them again).
     #[test]
     fn the_version_changes_with_the_cells() {
         let rect = PixelRect::new(0, 0, 16, 16);
