@@ -23,9 +23,7 @@
 
 use std::time::Instant;
 
-use rayon::prelude::*;
-
-use super::{Pass, PerWorker, TileContext, setup2d};
+use super::{Pass, TileContext, setup2d};
 use crate::aa::SamplePattern;
 use crate::camera::View;
 use crate::edge::{Coverage, HomogeneousVertex, Shared3D, Triangle3D, setup_homogeneous_from};
@@ -114,19 +112,10 @@ pub(super) fn resolve_bands(
 ) -> Pass {
     let mut pass = Pass::default();
     let rects = fb.tile_rects(context.view.width, BAND);
-    let workers = PerWorker::new();
-    let done: Vec<_> = pass
-        .planes(fb, &rects)
-        .into_par_iter()
-        .map(|planes| {
-            workers.with(|cache| {
-                context.run_tile(cache, planes, |tile| {
-                    copy(tile);
-                    Default::default()
-                })
-            })
-        })
-        .collect();
+    let done = context.run_tiles(&mut pass, fb, &rects, |_, (), tile| {
+        copy(tile);
+        crate::stats::RasterCounters::default()
+    });
     pass.add(done);
     pass
 }

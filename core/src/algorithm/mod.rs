@@ -23,6 +23,8 @@ pub(crate) mod setup2d;
 pub(crate) mod setup3d;
 pub(crate) mod tiles;
 
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -42,7 +44,7 @@ use crate::screen_boxes::ScreenBoxes;
 use crate::shade::Shader;
 use crate::stats::{CoverageHistogram, RasterCounters, Stats};
 use crate::trace::Trace;
-use crate::traversal::{LeafCache, Setup, Traversal};
+use crate::traversal::{Setup, Traversal};
 use tiles::rasterize_tiled;
 
 /// Renders `view` of `scene` with `pipeline` at `precision` into `fb`: the
@@ -240,21 +242,12 @@ fn render_frusta<'a, T: Stored + Copy>(
     let boxes = &boxes;
     let mut pass = Pass::default();
     let rects = fb.tile_rects(oracles.frustum, oracles.frustum);
-    let workers = PerWorker::<(Option<TileBuffer>, LeafCache<T>)>::new();
-    let done: Vec<_> = pass
-        .planes(fb, &rects)
-        .into_par_iter()
-        .map(|planes| {
-            workers.with(|(cache, leaves)| {
-                context.run_tile(cache, planes, |tile| {
-                    let how = (setup, shared, boxes);
-                    let mut t = Traversal::new(scene, context.view, oracles, tile, how, leaves);
-                    t.run();
-                    (t.counters, t.nodes_visited, t.setups)
-                })
-            })
-        })
-        .collect();
+    let done = context.run_tiles(&mut pass, fb, &rects, |_, leaves, tile| {
+        let how = (setup, shared, boxes);
+        let mut t = Traversal::new(scene, context.view, oracles, tile, how, leaves);
+        t.run();
+        (t.counters, t.nodes_visited, t.setups)
+    });
     pass.add(done.into_iter().map(|finished| {
         let (counters, nodes, setups) = finished.result;
         stats.bvh_nodes_visited += nodes;
@@ -337,7 +330,7 @@ impl<'a> TileContext<'a> {
     /// shades their samples straight into the frame's `planes`. The sample
     /// buffers are `cache`'s, reused from the worker's previous tile when
     /// there is one (no fresh pages to fault in per tile).
-    pub fn run_tile<R: Default>(
+    fn run_tile<R: Default>(
         &self,
         cache: &mut Option<TileBuffer<'a>>,
         mut planes: TilePlanes,
@@ -381,37 +374,55 @@ impl<'a> TileContext<'a> {
             trace,
         }
     }
-}
 
-/// What each worker thread of the render's pool keeps from one work item to
-/// the next: its tile buffers (and a traversal's leaf cache), made once per
-/// worker. (`map_init` makes one per rayon split, and a pool of more threads
-/// than cores splits a frame nearly once per tile: bunny `3dr-full` at 1080p
-/// made about 100 fresh 350 KB caches for 135 tiles with 8 threads on two
-/// cores, 20 with 2.)
-pub(crate) struct PerWorker<T> {
-    slots: Vec<std::sync::Mutex<T>>,
-}
-
-impl<T: Default> PerWorker<T> {
-    /// One value per thread of the current pool.
-    pub(crate) fn new() -> PerWorker<T> {
-        let slots = (0..rayon::current_num_threads()).map(|_| Default::default());
-        PerWorker {
-            slots: slots.collect(),
-        }
-    }
-
-    /// `work` with this thread's value, or with a fresh one where the thread
-    /// has none free (not a worker of the pool, or work nested in its own).
-    pub(crate) fn with<R>(&self, work: impl FnOnce(&mut T) -> R) -> R {
-        let mine = rayon::current_thread_index()
-            .and_then(|i| self.slots.get(i))
-            .and_then(|slot| slot.try_lock().ok());
-        match mine {
-            Some(mut value) => work(&mut value),
-            None => work(&mut T::default()),
-        }
+    /// Renders every tile of `rects` with `render` (given the tile's index, its
+    /// worker's `W`, and its sample buffers) and resolves it into `fb`'s planes;
+    /// returns the finished tiles in `rects`' order. One worker per thread of
+    /// the pool takes the next tile from a shared counter until none is left,
+    /// keeping its tile buffers and its `W` (a traversal's leaf cache) from one
+    /// tile to the next: made once per worker and frame, however the pool is
+    /// split. (rayon's `map_init` makes them once per split, and a pool of more
+    /// threads than cores splits a frame nearly once per tile.)
+    pub fn run_tiles<W: Default, R: Default + Send>(
+        &self,
+        pass: &mut Pass,
+        fb: &mut Framebuffer,
+        rects: &[PixelRect],
+        render: impl Fn(usize, &mut W, &mut TileBuffer<'a>) -> R + Sync,
+    ) -> Vec<Finished<R>> {
+        let planes: Vec<_> = pass
+            .planes(fb, rects)
+            .into_iter()
+            .map(|p| Mutex::new(Some(p)))
+            .collect();
+        let next = AtomicUsize::new(0);
+        let worker = |_| {
+            let (mut cache, mut mine) = (None, W::default());
+            let mut done = Vec::new();
+            loop {
+                let t = next.fetch_add(1, Ordering::Relaxed);
+                let Some(slot) = planes.get(t) else {
+                    return done;
+                };
+                // Each index is taken once: the lock is never contended, and
+                // the slot still holds its planes.
+                let taken = slot.lock().unwrap_or_else(|e| e.into_inner()).take();
+                let Some(planes) = taken else {
+                    continue;
+                };
+                done.push((
+                    t,
+                    self.run_tile(&mut cache, planes, |tile| render(t, &mut mine, tile)),
+                ));
+            }
+        };
+        let mut done: Vec<_> = (0..rayon::current_num_threads().min(planes.len()))
+            .into_par_iter()
+            .with_max_len(1)
+            .flat_map_iter(worker)
+            .collect();
+        done.sort_unstable_by_key(|&(t, _)| t);
+        done.into_iter().map(|(_, finished)| finished).collect()
     }
 }
 

@@ -6,11 +6,9 @@
 
 use std::time::Instant;
 
-use rayon::prelude::*;
-
 use super::setup3d::{self, SetupEight};
 use super::tiles::Setups;
-use super::{Pass, PerWorker, PixelRect, TileContext};
+use super::{Pass, PixelRect, TileContext};
 use crate::aa::SamplePattern;
 use crate::bvh::{PACKET, PacketRays};
 use crate::camera::View;
@@ -62,16 +60,9 @@ pub(crate) fn render_raycast<'a, T: Stored>(
     let start = Instant::now();
     let mut pass = Pass::default();
     let bands = fb.tile_rects(fb.width, BAND_ROWS);
-    let workers = PerWorker::new();
-    let done: Vec<_> = pass
-        .planes(fb, &bands)
-        .into_par_iter()
-        .map(|planes| {
-            workers.with(|cache| {
-                context.run_tile(cache, planes, |tile| cast_band(scene, view, &setups, tile))
-            })
-        })
-        .collect();
+    let done = context.run_tiles(&mut pass, fb, &bands, |_, (), tile| {
+        cast_band(scene, view, &setups, tile)
+    });
     pass.add(done.into_iter().map(|finished| {
         stats.bvh_nodes_visited += finished.result;
         finished.map(|_| Default::default())

@@ -5,7 +5,7 @@
 
 use rayon::prelude::*;
 
-use super::{Pass, PerWorker, PixelRect, TileContext};
+use super::{Pass, PixelRect, TileContext};
 use crate::edge::Stored;
 use crate::framebuffer::{Framebuffer, TileBuffer};
 use crate::simd;
@@ -179,41 +179,29 @@ pub(crate) fn rasterize_tiled<T: Stored>(
     // 2. Tiles in parallel, in input order within a tile, each resolved by
     // its worker (the samples never outlive their tile).
     let rects = fb.tile_rects(TILE_WIDTH, TILE_HEIGHT);
-    let workers = PerWorker::new();
     let mut pass = Pass::default();
-    let done: Vec<_> = pass
-        .planes(fb, &rects)
-        .into_par_iter()
-        .enumerate()
-        .map(|(t, planes)| {
-            workers.with(|cache| {
-                context.run_tile(cache, planes, |tile| {
-                    let mut counters = RasterCounters::default();
-                    let members: Vec<u32> =
-                        runs.iter().flat_map(|run| run.of(t)).copied().collect();
-                    for (i, &k) in members.iter().enumerate() {
-                        // The records of an item a few places on are on their
-                        // way while this one is rasterized (they are far apart
-                        // in memory, and a small triangle takes less time than
-                        // a miss).
-                        if let Some(&next) = members.get(i + PREFETCH_AHEAD) {
-                            simd::prefetch(&items.boxes[next as usize]);
-                            simd::prefetch(&items.triangles[next as usize]);
-                        }
-                        // Only items with a box (and so a triangle) were sorted into tiles.
-                        let Some((rect, id, tri)) = items.get(k as usize) else {
-                            continue;
-                        };
-                        // Non-empty: the item was sorted into this tile by its rect.
-                        if let Some(clip) = rect.intersect(tile.rect()) {
-                            kernel(tile, &tri, id, clip, &mut counters);
-                        }
-                    }
-                    counters
-                })
-            })
-        })
-        .collect();
+    let done = context.run_tiles(&mut pass, fb, &rects, |t, (), tile| {
+        let mut counters = RasterCounters::default();
+        let members: Vec<u32> = runs.iter().flat_map(|run| run.of(t)).copied().collect();
+        for (i, &k) in members.iter().enumerate() {
+            // The records of an item a few places on are on their way while
+            // this one is rasterized (they are far apart in memory, and a
+            // small triangle takes less time than a miss).
+            if let Some(&next) = members.get(i + PREFETCH_AHEAD) {
+                simd::prefetch(&items.boxes[next as usize]);
+                simd::prefetch(&items.triangles[next as usize]);
+            }
+            // Only items with a box (and so a triangle) were sorted into tiles.
+            let Some((rect, id, tri)) = items.get(k as usize) else {
+                continue;
+            };
+            // Non-empty: the item was sorted into this tile by its rect.
+            if let Some(clip) = rect.intersect(tile.rect()) {
+                kernel(tile, &tri, id, clip, &mut counters);
+            }
+        }
+        counters
+    });
     pass.add(done);
     pass
 }
