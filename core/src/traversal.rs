@@ -113,14 +113,6 @@ struct NodeBox {
     min_w: f32,
 }
 
-impl NodeBox {
-    const EMPTY: NodeBox = NodeBox {
-        lo: Vec3A::ZERO,
-        hi: Vec3A::ZERO,
-        min_w: 0.0,
-    };
-}
-
 /// `n·(corner − eye)` for each box of `boxes`, `corner` its corner furthest
 /// along `n` (`furthest`) or against it, in [`dot`]'s order.
 #[inline(always)]
@@ -358,12 +350,19 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
             tests.boxes.hi.map(|l| l.to_array()),
         );
         let min_w = tests.min_w.to_array();
-        let mut children = [(0.0, NodeRef::Inner(index), NodeBox::EMPTY, false); 8];
+        // Sorted as (distance, slot) pairs (stable: ties keep slot order),
+        // each child's box and reference made when it is visited.
+        let mut order = [(0.0f32, 0u8); 8];
         let mut len = 0;
-        for c in 0..8 {
-            if n.is_child_empty(c) {
-                continue;
+        for (c, &w) in min_w.iter().enumerate() {
+            if !n.is_child_empty(c) {
+                order[len] = (w, c as u8);
+                len += 1;
             }
+        }
+        order[..len].sort_by(|a, b| a.0.total_cmp(&b.0));
+        for &(min_w, c) in &order[..len] {
+            let c = usize::from(c);
             let r = if n.is_leaf(c) {
                 let (start, count) = n.child_primitives(c);
                 NodeRef::Leaf { start, count }
@@ -373,14 +372,9 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
             let b = NodeBox {
                 lo: Vec3A::new(lo[0][c], lo[1][c], lo[2][c]),
                 hi: Vec3A::new(hi[0][c], hi[1][c], hi[2][c]),
-                min_w: min_w[c],
+                min_w,
             };
-            children[len] = (b.min_w, r, b, outside >> c & 1 == 1);
-            len += 1;
-        }
-        children[..len].sort_by(|a, b| a.0.total_cmp(&b.0));
-        for &(_, r, b, outside) in &children[..len] {
-            self.visit(frustum, r, b, outside);
+            self.visit(frustum, r, b, outside >> c & 1 == 1);
         }
     }
 
