@@ -313,12 +313,12 @@ pub(crate) use dispatch;
 /// would hold up retirement until it arrived). For loops that know the next
 /// element's address while they work on the current one.
 #[inline(always)]
-pub(crate) fn prefetch<T>(value: &T) {
+pub(crate) fn prefetch<T: ?Sized>(value: &T) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
         let first = (value as *const T).cast::<i8>();
-        let size = size_of::<T>();
+        let size = size_of_val(value);
         // A line every 64 bytes and the last byte's: every line the value
         // touches holds one of them.
         let last = size.saturating_sub(1);

@@ -24,7 +24,7 @@ use crate::ground::PixelRect;
 use crate::pipeline::TraversalOracles;
 use crate::prepared::PreparedScene;
 use crate::screen_boxes::ScreenBoxes;
-use crate::simd::{Lanes, Portable};
+use crate::simd::{self, Lanes, Portable};
 use crate::stats::RasterCounters;
 use crate::trace::{FrustumEvent, NodeOutcome};
 
@@ -361,6 +361,29 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
             }
         }
         order[..len].sort_by(|a, b| a.0.total_cmp(&b.0));
+        // What the children inside the frustum will read first is on its way
+        // while the nearest is visited: an inner child's node, a leaf's
+        // vertex indices and corners (each a likely miss on a large scene).
+        let scene = self.scene;
+        for &(_, c) in &order[..len] {
+            let c = usize::from(c);
+            if outside >> c & 1 == 1 {
+                continue;
+            }
+            if n.is_leaf(c) {
+                let (start, count) = n.child_primitives(c);
+                let slots = start as usize..(start + count) as usize;
+                if let (Some(v), Some(p)) = (
+                    scene.slot_vertices.get(slots.clone()),
+                    scene.slot_corners.get(slots),
+                ) {
+                    simd::prefetch(v);
+                    simd::prefetch(p);
+                }
+            } else if let Some(child) = scene.bvh.cwbvh.nodes.get(n.child_node_index(c) as usize) {
+                simd::prefetch(child);
+            }
+        }
         for &(min_w, c) in &order[..len] {
             let c = usize::from(c);
             let r = if n.is_leaf(c) {
