@@ -24,14 +24,27 @@ fn encode_srgb_formula(v: f32) -> u8 {
 /// Buckets of the encoding table over [0, 1].
 const SRGB_BUCKETS: usize = 4096;
 
-/// [`encode_srgb_formula`] as tables: the first byte of each of
-/// [`SRGB_BUCKETS`] equal buckets (and of `1.0`, past the last), and per byte
-/// the smallest linear value that encodes to it (found by bisection over
-/// `f32` bit patterns, which order non-negative values), with `+∞` after the
-/// last: no byte past 255.
+/// [`encode_srgb_formula`] as a table of [`SRGB_BUCKETS`] equal buckets
+/// over [0, 1] (and one for `1.0`, past the last). A bucket is narrower than
+/// the transfer function's smallest byte step (2.4e-4 against 3.0e-4, the
+/// step of its linear part, which is also its steepest), so at most one
+/// byte starts inside it — checked when the table is built: each bucket
+/// holds its first byte and where the next byte starts (`+∞` when not inside
+/// it). The byte starts ("thresholds", the smallest linear value encoding to
+/// each byte) are found by bisection over `f32` bit patterns, which order
+/// non-negative values.
 struct SrgbTable {
-    bucket_start: [u8; SRGB_BUCKETS + 1],
+    buckets: [Bucket; SRGB_BUCKETS + 1],
+    #[cfg(test)]
     thresholds: [f32; 257],
+}
+
+/// One bucket of an [`SrgbTable`]: the byte its first value encodes to, and
+/// the smallest value of the next byte (may lie past the bucket).
+#[derive(Clone, Copy, Default)]
+struct Bucket {
+    next: f32,
+    first: u8,
 }
 
 fn srgb_table() -> &'static SrgbTable {
@@ -51,10 +64,23 @@ fn srgb_table() -> &'static SrgbTable {
             }
             *t = f32::from_bits(lo);
         }
-        let bucket_start =
-            std::array::from_fn(|i| encode_srgb_formula(i as f32 / SRGB_BUCKETS as f32));
+        let mut buckets = [Bucket::default(); SRGB_BUCKETS + 1];
+        for (i, bucket) in buckets.iter_mut().enumerate() {
+            let first = encode_srgb_formula(i as f32 / SRGB_BUCKETS as f32);
+            let (next, after) = match usize::from(first) {
+                255 => (f32::INFINITY, f32::INFINITY),
+                b => (thresholds[b + 1], thresholds[b + 2]),
+            };
+            // The bucket's values lie below (i + 1) / SRGB_BUCKETS (exact).
+            assert!(
+                after >= (i + 1) as f32 / SRGB_BUCKETS as f32,
+                "sRGB bucket {i} holds two byte steps"
+            );
+            *bucket = Bucket { next, first };
+        }
         SrgbTable {
-            bucket_start,
+            buckets,
+            #[cfg(test)]
             thresholds,
         }
     })
@@ -62,28 +88,22 @@ fn srgb_table() -> &'static SrgbTable {
 
 impl SrgbTable {
     /// [`encode_srgb`] without a branch for its special values: `v ≥ 1`
-    /// (`+∞` too) is read as `1`, whose bucket starts at 255; NaN and `v ≤ 0`
-    /// land in bucket 0 (the float-to-integer cast saturates, NaN to 0) and
-    /// never reach `thresholds[1] > 0`.
+    /// (`+∞` too) is read as `1`, whose bucket's byte is 255 with no next;
+    /// NaN and `v ≤ 0` land in bucket 0 (the float-to-integer cast
+    /// saturates, NaN to 0) and never reach its next byte's start (`> 0`).
+    /// Two independent loads (one bucket record), no loop.
     #[inline(always)]
     fn encode(&self, v: f32) -> u8 {
         let v = if v >= 1.0 { 1.0 } else { v };
         // Exact: scaling by a power of two does not round.
-        let bucket = ((v * SRGB_BUCKETS as f32) as usize).min(SRGB_BUCKETS);
-        let mut b = self.bucket_start[bucket];
-        // A bucket is narrower than a byte's step almost everywhere: the first
-        // step without a branch, a second in the loop's rare turn.
-        b += u8::from(v >= self.thresholds[usize::from(b) + 1]);
-        while v >= self.thresholds[usize::from(b) + 1] {
-            b += 1;
-        }
-        b
+        let bucket = &self.buckets[((v * SRGB_BUCKETS as f32) as usize).min(SRGB_BUCKETS)];
+        bucket.first + u8::from(v >= bucket.next)
     }
 }
 
 /// Linear [0, 1] → sRGB byte, exactly the transfer function (tested on
-/// every threshold and millions of values) without its `powf`: the bucket's
-/// first byte, then up past the thresholds `v` reaches (at most a step or two).
+/// every threshold and millions of values) without its `powf`: the
+/// bucket's first byte, and the next where `v` reaches its start.
 #[cfg(test)]
 fn encode_srgb(v: f32) -> u8 {
     srgb_table().encode(v)
