@@ -35,12 +35,13 @@ impl<L: Lanes> V3<L> {
         }
     }
 
+    /// Eight vectors given axis by axis.
     #[inline(always)]
-    fn of(v: &[Vec3; 8]) -> Self {
+    fn of([x, y, z]: &[[f32; 8]; 3]) -> Self {
         V3 {
-            x: L::from_array(v.map(|v| v.x)),
-            y: L::from_array(v.map(|v| v.y)),
-            z: L::from_array(v.map(|v| v.z)),
+            x: L::from_array(*x),
+            y: L::from_array(*y),
+            z: L::from_array(*z),
         }
     }
 
@@ -174,10 +175,12 @@ impl Shader<'_> {
         // 1. What each lane's triangle brings (lanes without one repeat the
         // first that has one, so that every lane computes on real values).
         let first = s.ids[done.trailing_zeros() as usize];
-        let mut corners = [[Vec3::ZERO; 8]; 3];
-        let mut vertex_normals = [[Vec3::ZERO; 8]; 3];
-        let mut base = [Vec3::ZERO; 8];
-        let mut emissive = [Vec3::ZERO; 8];
+        // Gathered straight into lanes: per vertex `k` and axis `a`, lane `l`
+        // at `[k][a][l]` (no transposes of 8 × Vec3 afterwards).
+        let mut corners = [[[0.0f32; 8]; 3]; 3];
+        let mut vertex_normals = [[[0.0f32; 8]; 3]; 3];
+        let mut base = [[0.0f32; 8]; 3];
+        let mut emissive = [[0.0f32; 8]; 3];
         // The lane that last gathered, its triangle, and whether one of
         // that triangle's vertex normals is zero (the scalar path's case).
         let mut previous: Option<(usize, usize, bool)> = None;
@@ -190,40 +193,42 @@ impl Shader<'_> {
             // Neighbouring samples mostly hold one triangle: its records are
             // the previous lane's (no second gather of the same ones).
             if let Some((_, last, zero_normal)) = previous.filter(|p| p.0 == id) {
-                for k in 0..3 {
-                    corners[k][l] = corners[k][last];
-                    vertex_normals[k][l] = vertex_normals[k][last];
+                for a in 0..3 {
+                    for k in 0..3 {
+                        corners[k][a][l] = corners[k][a][last];
+                        vertex_normals[k][a][l] = vertex_normals[k][a][last];
+                    }
+                    (base[a][l], emissive[a][l]) = (base[a][last], emissive[a][last]);
                 }
-                (base[l], emissive[l]) = (base[last], emissive[last]);
                 if zero_normal {
                     done &= !(1 << l);
                 }
                 continue;
             }
             let (p, vertices) = prepared.corners_and_vertices(id as u32);
-            for k in 0..3 {
-                corners[k][l] = p[k];
-            }
             let material = &prepared.scene.materials[self.material_of(id as u32) as usize];
-            base[l] = Vec3::from_slice(&material.base_color[..3]);
-            emissive[l] = Vec3::from(material.emissive);
+            for a in 0..3 {
+                for k in 0..3 {
+                    corners[k][a][l] = p[k][a];
+                }
+                (base[a][l], emissive[a][l]) = (material.base_color[a], material.emissive[a]);
+            }
             let mut zero_normal = false;
             if interpolated {
                 for (k, &v) in vertices.iter().enumerate() {
-                    vertex_normals[k][l] = mesh.normals[v as usize];
+                    let n = mesh.normals[v as usize];
+                    zero_normal |= n == Vec3::ZERO;
+                    for a in 0..3 {
+                        vertex_normals[k][a][l] = n[a];
+                    }
                 }
-                zero_normal = (0..3).any(|k| vertex_normals[k][l] == Vec3::ZERO);
                 if zero_normal {
                     done &= !(1 << l);
                 }
             }
             previous = Some((id, l, zero_normal));
         }
-        let (p0, p1, p2) = (
-            V3::<L>::of(&corners[0]),
-            V3::of(&corners[1]),
-            V3::of(&corners[2]),
-        );
+        let [p0, p1, p2] = corners.map(|c| V3::<L>::of(&c));
 
         // 2. The ray through each sample (`View::origin`, `View::direction`).
         let view = self.view;
