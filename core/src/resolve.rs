@@ -121,15 +121,25 @@ fn resolve_tile(tile: &TileBuffer, out: &mut TilePlanes) -> TileTotals {
     let (stored, pixels) = (pattern.stored, tile.pixels);
     let width = (tile.x1 - tile.x0) as usize;
     let masks = pattern.has_coverage_only();
+    // The counters are taken row by row, while the row is in cache.
+    let (mut histogram, mut edge_evaluations, mut max_edge_evals) =
+        (CoverageHistogram::default(), 0u64, 0u32);
     for (r, start) in (0..pixels).step_by(width).enumerate() {
         let row = start..start + width;
         out.depth[r].copy_from_slice(&tile.depth[row.clone()]);
         out.triangle_id[r].copy_from_slice(&tile.triangle_id[row.clone()]);
-        out.edge_evals[r].copy_from_slice(&tile.edge_evals[row.clone()]);
+        let evals = &tile.edge_evals[row.clone()];
+        out.edge_evals[r].copy_from_slice(evals);
+        for &e in evals {
+            (edge_evaluations, max_edge_evals) =
+                (edge_evaluations + u64::from(e), max_edge_evals.max(e));
+        }
         let writes = &mut *out.coverage_writes[r];
         writes.copy_from_slice(&tile.coverage_writes[row.clone()]);
+        histogram += CoverageHistogram::of(writes);
         for s in 1..stored {
             let layer = &tile.coverage_writes[s * pixels + start..][..width];
+            histogram += CoverageHistogram::of(layer);
             for (sum, &w) in writes.iter_mut().zip(layer) {
                 *sum += w;
             }
@@ -151,12 +161,8 @@ fn resolve_tile(tile: &TileBuffer, out: &mut TilePlanes) -> TileTotals {
             }
         }
     }
-    let (edge_evaluations, max_edge_evals) = (tile.edge_evals.iter())
-        .fold((0u64, 0u32), |(sum, max), &e| {
-            (sum + u64::from(e), max.max(e))
-        });
     TileTotals {
-        histogram: CoverageHistogram::of(&tile.coverage_writes),
+        histogram,
         edge_evaluations,
         max_edge_evals,
         ..TileTotals::default()
