@@ -16,7 +16,7 @@ use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::node::{CwBvhNode, extract_byte64};
 
-use crate::simd::{Lanes, Portable};
+use crate::simd::{Lanes, Portable, abs};
 
 /// Relative padding of every box, beyond CWBVH quantisation and rounding.
 pub const BOX_PAD: f32 = 1.0 / (1 << 18) as f32;
@@ -54,12 +54,6 @@ pub(crate) struct Children<L> {
 #[inline(always)]
 fn byte_lanes<L: Lanes>(bytes: &[u8; 8]) -> L {
     L::from_array(bytes.map(f32::from))
-}
-
-/// `|x|` per lane (`maxps(x, −x)`; boxes hold no NaN).
-#[inline(always)]
-fn abs<L: Lanes>(x: L) -> L {
-    x.max(L::splat(0.0) - x)
 }
 
 impl<L: Lanes> Children<L> {

@@ -23,7 +23,7 @@ use crate::edge::EPS;
 use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
-use crate::simd::{self, Lanes};
+use crate::simd::{self, Lanes, abs, finite};
 
 /// Non-planar viewports' screen box: the bounds of the triangle's cap of
 /// directions ([`crate::camera::SphereMap::bounds_of`]), padded by a pixel.
@@ -193,6 +193,70 @@ impl ImageMap {
         image_box.magnitude().is_finite().then_some(image_box)
     }
 
+    /// [`ImageMap::box_bounds`] and [`ImageBox::pixels`] of eight boxes, one
+    /// per lane (`lo`, `hi` per axis): the same operations in the same order
+    /// (`Vec3::dot` as `(x·x' + y·y') + z·z'`, no fused multiply-add), so the
+    /// same pixels wherever every image bound is finite. Returns the rects
+    /// and the lanes where one is not (beyond the near bound, but unsure:
+    /// the scalar `min`/`max` pass over a NaN where the lanes' do not).
+    #[inline(always)]
+    fn box_rects<L: Lanes>(
+        &self,
+        lo: &[L; 3],
+        hi: &[L; 3],
+        view: &View,
+        span: SampleSpan,
+    ) -> ([Option<PixelRect>; 8], u8) {
+        let eye = view.eye;
+        let o = eye + self.origin.unwrap_or(Vec3::ZERO);
+        let half_of = L::splat(0.5);
+        let mut mid = [L::splat(0.0); 3];
+        let mut reach = [L::splat(0.0); 3];
+        for a in 0..3 {
+            mid[a] = (lo[a] + hi[a]) * half_of - L::splat(o[a]);
+            let half = (hi[a] - lo[a]) * half_of;
+            let magnitude = ((abs(mid[a]) + half) + L::splat(eye[a].abs())) + L::splat(o[a].abs());
+            reach[a] = half + magnitude * L::splat(32.0 * EPS);
+        }
+        let dot = |r: Vec3, v: &[L; 3]| {
+            (L::splat(r.x) * v[0] + L::splat(r.y) * v[1]) + L::splat(r.z) * v[2]
+        };
+        let [ra, rb, rc] = self.rows;
+        let [ea, eb, ec] = self.rows_abs.map(|r| dot(r, &reach));
+        let (a, b, c) = (dot(ra, &mid), dot(rb, &mid), dot(rc, &mid));
+        let clo = c - ec;
+        let beyond = clo.ge(L::splat(self.near_bound)) & clo.gt(L::splat(0.0));
+        let (xs, ys) = ([a - ea, a + ea], [b - eb, b + eb]);
+        let (inf, neg_inf) = (L::splat(f32::INFINITY), L::splat(f32::NEG_INFINITY));
+        let (mut min_x, mut min_y, mut max_x, mut max_y) = (inf, inf, neg_inf, neg_inf);
+        let mut all_finite = u8::MAX;
+        let mut grow = |x: L, y: L| {
+            all_finite &= finite(x) & finite(y);
+            (min_x, min_y) = (min_x.min(x), min_y.min(y));
+            (max_x, max_y) = (max_x.max(x), max_y.max(y));
+        };
+        if self.origin.is_some() {
+            grow(xs[0], ys[0]);
+            grow(xs[1], ys[1]);
+        } else {
+            for inverse in [L::splat(1.0) / clo, L::splat(1.0) / (c + ec)] {
+                for k in 0..2 {
+                    grow(xs[k] * inverse, ys[k] * inverse);
+                }
+            }
+        }
+        let magnitude = abs(min_x).max(abs(min_y)).max(abs(max_x)).max(abs(max_y));
+        let pad = L::splat(8.0 * EPS) * magnitude + L::splat(1.0 / 1024.0);
+        let size = [view.width, view.height];
+        let mut rects = padded_rects([min_x, min_y, max_x, max_y], pad, size, span);
+        for (l, rect) in rects.iter_mut().enumerate() {
+            if beyond >> l & 1 == 0 {
+                *rect = None;
+            }
+        }
+        (rects, beyond & !all_finite)
+    }
+
     /// The box of the triangle `p` with vertex image points `points`: theirs
     /// when all three are projected; `None` when all three are nearer than
     /// the bound (so is every point of the triangle, which has no sample at
@@ -349,6 +413,32 @@ impl ScreenBoxes {
         rects
     }
 
+    /// [`ScreenBoxes::node_rect`] of the boxes of `lanes` (bit per lane; `lo`,
+    /// `hi` per axis and lane): the same rects, computed eight at a time
+    /// ([`node_rects_eight`]) and by `node_rect` itself in a lane whose
+    /// bounds are not all finite. Lanes outside `lanes` hold anything.
+    pub(crate) fn node_rects(
+        &self,
+        lo: &[[f32; 8]; 3],
+        hi: &[[f32; 8]; 3],
+        lanes: u8,
+        view: &View,
+        span: SampleSpan,
+    ) -> [Option<PixelRect>; 8] {
+        let Some(map) = &self.map else {
+            return [None; 8];
+        };
+        let (mut rects, unsure) = node_rects_eight(map, lo, hi, view, span);
+        let unsure = unsure & lanes;
+        for (l, rect) in rects.iter_mut().enumerate() {
+            if unsure >> l & 1 == 1 {
+                let corner = |v: &[[f32; 8]; 3]| Vec3::new(v[0][l], v[1][l], v[2][l]);
+                *rect = self.node_rect(corner(lo), corner(hi), view, span);
+            }
+        }
+        rects
+    }
+
     /// The pixels with a sample in a conservative screen box of the
     /// axis-aligned box `lo..hi` ([`ImageMap::box_bounds`]): every pixel a
     /// triangle with its vertices inside may cover. `None` on non-planar views
@@ -366,6 +456,28 @@ impl ScreenBoxes {
             .box_bounds(lo, hi, view.eye)?
             .pixels(view, span)
     }
+}
+
+simd::dispatch! {
+    /// [`ImageMap::box_rects`] of eight boxes given per axis and lane.
+    fn node_rects_eight<>(
+        map: &ImageMap,
+        lo: &[[f32; 8]; 3],
+        hi: &[[f32; 8]; 3],
+        view: &View,
+        span: SampleSpan,
+    ) -> ([Option<PixelRect>; 8], u8) => node_rects_eight_on
+}
+
+#[inline(always)]
+fn node_rects_eight_on<L: Lanes>(
+    map: &ImageMap,
+    lo: &[[f32; 8]; 3],
+    hi: &[[f32; 8]; 3],
+    view: &View,
+    span: SampleSpan,
+) -> ([Option<PixelRect>; 8], u8) {
+    map.box_rects::<L>(&lo.map(L::from_array), &hi.map(L::from_array), view, span)
 }
 
 /// Eight triangles' projected vertices: x, y and rounding bound (as in
@@ -403,7 +515,19 @@ fn pixels_eight_on<L: Lanes>(
         (max_x, max_y) = (max_x.max(x), max_y.max(y));
         pad = pad.max(L::from_array(pads[k]));
     }
-    // `PixelRect::from_bounds` of the padded box.
+    padded_rects([min_x, min_y, max_x, max_y], pad, [width, height], span)
+}
+
+/// `PixelRect::from_bounds` of eight boxes `[min_x, min_y, max_x, max_y]`
+/// padded by `pad`, one per lane (the same operations, so the same pixels on
+/// finite bounds).
+#[inline(always)]
+fn padded_rects<L: Lanes>(
+    [min_x, min_y, max_x, max_y]: [L; 4],
+    pad: L,
+    [width, height]: [u32; 2],
+    span: SampleSpan,
+) -> [Option<PixelRect>; 8] {
     let zero = L::splat(0.0);
     let x0 = ((min_x - pad) - L::splat(span.hi[0])).ceil().max(zero);
     let y0 = ((min_y - pad) - L::splat(span.hi[1])).ceil().max(zero);
@@ -785,6 +909,82 @@ mod tests {
         );
         // `pixels_eight` takes AVX2 where the CPU has it.
         eight_boxes_are_the_single_ones(pixels_eight);
+    }
+
+    /// [`ScreenBoxes::node_rects`] is [`ScreenBoxes::node_rect`] per box, on
+    /// perspective and orthographic views near and far from the origin, for
+    /// boxes in view, across the near plane, behind the eye, and large
+    /// enough that their bounds overflow (the lanes' scalar fallback).
+    #[test]
+    fn node_rects_of_eight_boxes_are_their_node_rects() {
+        fn lanes<L: Lanes>(v: &[[f32; 8]; 3]) -> [L; 3] {
+            v.map(L::from_array)
+        }
+        let mut rng = fastrand::Rng::with_seed(31);
+        let (mut checked, mut some, mut in_lanes, mut fallback) = (0, 0, 0, 0);
+        for case in 0..2_000 {
+            let far = [0.0, 1e3, 3e5][case % 3];
+            let eye = Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5) * 4.0
+                + Vec3::splat(far);
+            let target = eye + Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, -1.0);
+            let viewport = match case % 4 {
+                0 => Viewport::Orthographic {
+                    height: [1e-3, 1.0, 50.0][rng.usize(0..3)],
+                },
+                _ => Viewport::Perspective {
+                    fov_y_deg: [0.5, 10.0, 60.0, 170.0][rng.usize(0..4)],
+                },
+            };
+            let size = (rng.u32(1..3000), rng.u32(1..3000));
+            let near = [1e-3, 0.1, 1.0][rng.usize(0..3)];
+            // One case in ten: an axis-aligned orthographic view of boxes
+            // 2e38 wide, whose image bounds overflow where their depth does not.
+            let overflow = case % 10 == 9;
+            let view = match overflow {
+                true => {
+                    let viewport = Viewport::Orthographic { height: 1e-3 };
+                    view(Vec3::ZERO, -Vec3::Z, viewport, size, near)
+                }
+                false => view(eye, target, viewport, size, near),
+            };
+            let span = SamplePattern::of(AA_FAMILIES[rng.usize(0..3)]).span;
+            let screen = ScreenBoxes::of(&[], &view);
+            let (mut lo, mut hi) = ([[0.0f32; 8]; 3], [[0.0f32; 8]; 3]);
+            for l in 0..8 {
+                let depth = [-2.0, 0.05, 0.5, 3.0, 100.0][rng.usize(0..5)];
+                let off = Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5);
+                let centre = eye + (target - eye) * depth + off * depth;
+                let size = [1e-4, 0.1, 2.0, 1e3, 1e37][rng.usize(0..5)];
+                for a in 0..3 {
+                    lo[a][l] = centre[a] - rng.f32() * size;
+                    hi[a][l] = centre[a] + rng.f32() * size;
+                }
+                if overflow {
+                    [lo[0][l], hi[0][l], lo[2][l], hi[2][l]] = [-1e38, 1e38, -3.0, -2.0];
+                }
+            }
+            // The dispatched kernel (AVX2 here) and the portable one.
+            let rects = screen.node_rects(&lo, &hi, u8::MAX, &view, span);
+            let map = screen.map.as_ref().expect("a planar view");
+            let (lane_lo, lane_hi) = (lanes::<simd::Portable>(&lo), lanes(&hi));
+            let (portable, unsure) = map.box_rects(&lane_lo, &lane_hi, &view, span);
+            fallback += unsure.count_ones();
+            for (l, rect) in rects.into_iter().enumerate() {
+                if unsure >> l & 1 == 0 {
+                    assert_eq!(portable[l], rect, "case {case} lane {l}: portable lanes");
+                }
+                let corner = |v: &[[f32; 8]; 3]| Vec3::new(v[0][l], v[1][l], v[2][l]);
+                let single = screen.node_rect(corner(&lo), corner(&hi), &view, span);
+                let at = format!("case {case} lane {l}: {lo:?}..{hi:?} on {view:?}");
+                assert_eq!(rect, single, "{at}");
+                checked += 1;
+                some += usize::from(single.is_some());
+                in_lanes += usize::from(single.is_some() && unsure >> l & 1 == 0);
+            }
+        }
+        assert_eq!(checked, 16_000);
+        assert!(in_lanes > 1_500, "{some} rects, {in_lanes} from lanes");
+        assert!(fallback > 100, "{fallback} lanes took the scalar fallback");
     }
 
     /// [`ScreenBoxes::rects_eight`] is [`ScreenBoxes::rect`] per triangle, on

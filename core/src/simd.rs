@@ -40,6 +40,19 @@ impl<L> Lanes for L where
 {
 }
 
+/// `|x|` per lane (`maxps(x, −x)`): `f32::abs` on every lane but a NaN.
+#[inline(always)]
+pub(crate) fn abs<L: Lanes>(x: L) -> L {
+    x.max(L::splat(0.0) - x)
+}
+
+/// The lanes holding a finite value (`v · 0` is ±0 exactly there, NaN elsewhere).
+#[inline(always)]
+pub(crate) fn finite<L: Lanes>(v: L) -> u8 {
+    let zero = L::splat(0.0);
+    (v * zero).eq(zero)
+}
+
 mod sealed {
     /// The lane operations beyond arithmetic. `max`/`min` are x86's `maxps`/
     /// `minps`: `self > o ? self : o` (the second operand when either is NaN),

@@ -105,12 +105,36 @@ enum NodeRef {
     Leaf { start: u32, count: u32 },
 }
 
-/// A box with its nearest view-axis distance.
+/// A box with its nearest view-axis distance, and where its screen rect
+/// comes from when occlusion culling needs it.
 #[derive(Clone, Copy, Debug)]
-struct NodeBox {
+struct NodeBox<'s> {
     lo: Vec3A,
     hi: Vec3A,
     min_w: f32,
+    rect: RectOf<'s>,
+}
+
+/// Where a node's screen rect ([`ScreenBoxes::node_rect`]) comes from.
+#[derive(Clone, Copy, Debug)]
+enum RectOf<'s> {
+    /// Made from the box when read (the root).
+    Own,
+    /// Child `c` of a node: every child's made together in lanes when the
+    /// first is read ([`ScreenBoxes::node_rects`]), then read by the others
+    /// and by the frusta its own frustum splits into.
+    Sibling(&'s SiblingRects<'s>, usize),
+}
+
+/// A node's children's boxes (per axis, a lane per child slot), and their
+/// screen rects once one was needed.
+#[derive(Debug)]
+struct SiblingRects<'s> {
+    lo: &'s [[f32; 8]; 3],
+    hi: &'s [[f32; 8]; 3],
+    /// Bit per child slot that holds a child.
+    present: u8,
+    rects: std::cell::OnceCell<[Option<PixelRect>; 8]>,
 }
 
 /// `n·(corner − eye)` for each box of `boxes`, `corner` its corner furthest
@@ -263,7 +287,7 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
         self.traverse(&f, NodeRef::Inner(0), root);
     }
 
-    fn node_box(&self, min: Vec3A, max: Vec3A) -> NodeBox {
+    fn node_box(&self, min: Vec3A, max: Vec3A) -> NodeBox<'static> {
         let (lo, hi) = padded(min, max);
         // Nearest w over the box: the corner furthest against the view axis.
         let f = Vec3A::from(self.view.forward);
@@ -272,6 +296,7 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
             lo,
             hi,
             min_w: dot(corner - Vec3A::from(self.view.eye), f),
+            rect: RectOf::Own,
         }
     }
 
@@ -353,13 +378,20 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
         // Sorted as (distance, slot) pairs (stable: ties keep slot order),
         // each child's box and reference made when it is visited.
         let mut order = [(0.0f32, 0u8); 8];
-        let mut len = 0;
+        let (mut len, mut present) = (0, 0u8);
         for (c, &w) in min_w.iter().enumerate() {
             if !n.is_child_empty(c) {
                 order[len] = (w, c as u8);
                 len += 1;
+                present |= 1 << c;
             }
         }
+        let siblings = SiblingRects {
+            lo: &lo,
+            hi: &hi,
+            present,
+            rects: std::cell::OnceCell::new(),
+        };
         order[..len].sort_by(|a, b| a.0.total_cmp(&b.0));
         // What the children inside the frustum will read first is on its way
         // while the nearest is visited: an inner child's node, a leaf's
@@ -396,6 +428,7 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
                 lo: Vec3A::new(lo[0][c], lo[1][c], lo[2][c]),
                 hi: Vec3A::new(hi[0][c], hi[1][c], hi[2][c]),
                 min_w,
+                rect: RectOf::Sibling(&siblings, c),
             };
             self.visit(frustum, r, b, outside >> c & 1 == 1);
         }
@@ -439,10 +472,15 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
             // Not behind any cell's held depths: no need to project the box.
             return false;
         }
-        let span = self.tile.pattern.span;
-        self.boxes
-            .node_rect(b.lo.into(), b.hi.into(), self.view, span)
-            .and_then(|r| r.intersect(f.rect))
+        let (view, span) = (self.view, self.tile.pattern.span);
+        let rect = match b.rect {
+            RectOf::Own => (self.boxes).node_rect(b.lo.into(), b.hi.into(), view, span),
+            RectOf::Sibling(siblings, c) => siblings.rects.get_or_init(|| {
+                let (lo, hi) = (siblings.lo, siblings.hi);
+                (self.boxes).node_rects(lo, hi, siblings.present, view, span)
+            })[c],
+        };
+        rect.and_then(|r| r.intersect(f.rect))
             .is_some_and(|r| self.tile.hiz.hides(r, b.min_w))
     }
 

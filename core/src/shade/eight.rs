@@ -15,7 +15,7 @@
 use glam::Vec3;
 
 use super::{AMBIENT, LightFrom, Shader};
-use crate::simd::Lanes;
+use crate::simd::{Lanes, finite};
 
 /// Three lanes of f32: eight vectors.
 #[derive(Clone, Copy)]
@@ -110,13 +110,6 @@ fn along<L: Lanes>([v0, vx, vy]: [Vec3; 3], x: L, y: L) -> V3<L> {
 #[inline(always)]
 fn ambient<L: Lanes>(lit: L) -> L {
     L::splat(AMBIENT) + L::splat(1.0 - AMBIENT) * lit
-}
-
-/// The lanes holding a finite value (`v · 0` is ±0 exactly there, NaN elsewhere).
-#[inline(always)]
-fn finite<L: Lanes>(v: L) -> u8 {
-    let zero = L::splat(0.0);
-    (v * zero).eq(zero)
 }
 
 /// Eight samples of one row, at `(x + l) + ox` and `y` for lane `l`:
