@@ -218,33 +218,36 @@ impl ImageMap {
             let magnitude = ((abs(mid[a]) + half) + L::splat(eye[a].abs())) + L::splat(o[a].abs());
             reach[a] = half + magnitude * L::splat(32.0 * EPS);
         }
-        let dot = |r: Vec3, v: &[L; 3]| {
-            (L::splat(r.x) * v[0] + L::splat(r.y) * v[1]) + L::splat(r.z) * v[2]
-        };
-        let [ra, rb, rc] = self.rows;
-        let [ea, eb, ec] = self.rows_abs.map(|r| dot(r, &reach));
-        let (a, b, c) = (dot(ra, &mid), dot(rb, &mid), dot(rc, &mid));
+        // Lane code: functions and loops, no closures (see `crate::simd`).
+        let ([ra, rb, rc], [sa, sb, sc]) = (self.rows, self.rows_abs);
+        let [ea, eb, ec] = [
+            dot_lanes(sa, &reach),
+            dot_lanes(sb, &reach),
+            dot_lanes(sc, &reach),
+        ];
+        let (a, b, c) = (
+            dot_lanes(ra, &mid),
+            dot_lanes(rb, &mid),
+            dot_lanes(rc, &mid),
+        );
         let clo = c - ec;
         let beyond = clo.ge(L::splat(self.near_bound)) & clo.gt(L::splat(0.0));
         let (xs, ys) = ([a - ea, a + ea], [b - eb, b + eb]);
         let (inf, neg_inf) = (L::splat(f32::INFINITY), L::splat(f32::NEG_INFINITY));
-        let (mut min_x, mut min_y, mut max_x, mut max_y) = (inf, inf, neg_inf, neg_inf);
+        let mut bounds = [inf, inf, neg_inf, neg_inf];
         let mut all_finite = u8::MAX;
-        let mut grow = |x: L, y: L| {
-            all_finite &= finite(x) & finite(y);
-            (min_x, min_y) = (min_x.min(x), min_y.min(y));
-            (max_x, max_y) = (max_x.max(x), max_y.max(y));
-        };
         if self.origin.is_some() {
-            grow(xs[0], ys[0]);
-            grow(xs[1], ys[1]);
+            for k in 0..2 {
+                all_finite &= grow_lanes(&mut bounds, xs[k], ys[k]);
+            }
         } else {
             for inverse in [L::splat(1.0) / clo, L::splat(1.0) / (c + ec)] {
                 for k in 0..2 {
-                    grow(xs[k] * inverse, ys[k] * inverse);
+                    all_finite &= grow_lanes(&mut bounds, xs[k] * inverse, ys[k] * inverse);
                 }
             }
         }
+        let [min_x, min_y, max_x, max_y] = bounds;
         let magnitude = abs(min_x).max(abs(min_y)).max(abs(max_x)).max(abs(max_y));
         let pad = L::splat(8.0 * EPS) * magnitude + L::splat(1.0 / 1024.0);
         let size = [view.width, view.height];
@@ -477,7 +480,17 @@ fn node_rects_eight_on<L: Lanes>(
     view: &View,
     span: SampleSpan,
 ) -> ([Option<PixelRect>; 8], u8) {
-    map.box_rects::<L>(&lo.map(L::from_array), &hi.map(L::from_array), view, span)
+    let lo = [
+        L::from_array(lo[0]),
+        L::from_array(lo[1]),
+        L::from_array(lo[2]),
+    ];
+    let hi = [
+        L::from_array(hi[0]),
+        L::from_array(hi[1]),
+        L::from_array(hi[2]),
+    ];
+    map.box_rects::<L>(&lo, &hi, view, span)
 }
 
 /// Eight triangles' projected vertices: x, y and rounding bound (as in
@@ -516,6 +529,21 @@ fn pixels_eight_on<L: Lanes>(
         pad = pad.max(L::from_array(pads[k]));
     }
     padded_rects([min_x, min_y, max_x, max_y], pad, [width, height], span)
+}
+
+/// `r · v` for eight vectors `v` (per axis), as `Vec3::dot` rounds it:
+/// `(x·x' + y·y') + z·z'`.
+#[inline(always)]
+fn dot_lanes<L: Lanes>(r: Vec3, v: &[L; 3]) -> L {
+    (L::splat(r.x) * v[0] + L::splat(r.y) * v[1]) + L::splat(r.z) * v[2]
+}
+
+/// Grows eight boxes `[min_x, min_y, max_x, max_y]` by a point each;
+/// returns the lanes where the point is finite.
+#[inline(always)]
+fn grow_lanes<L: Lanes>(b: &mut [L; 4], x: L, y: L) -> u8 {
+    *b = [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)];
+    finite(x) & finite(y)
 }
 
 /// `PixelRect::from_bounds` of eight boxes `[min_x, min_y, max_x, max_y]`
