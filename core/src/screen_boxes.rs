@@ -682,6 +682,30 @@ mod tests {
     /// A point (rounded to f32) at depth `t` on the ray of image point
     /// `(x, y)`, computed in f64: within rounding of that sample's ray, where
     /// rounding decides whether the sample is covered.
+    /// A camera of test case `case`: an eye near the origin or far from it,
+    /// looking roughly down −z; orthographic in one case of `orthographic`,
+    /// else perspective with one of `fovs`.
+    fn random_look(
+        rng: &mut fastrand::Rng,
+        case: usize,
+        orthographic: usize,
+        fovs: &[f32],
+    ) -> (Vec3, Vec3, Viewport) {
+        let far = [0.0, 1e3, 3e5][case % 3];
+        let eye =
+            Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5) * 4.0 + Vec3::splat(far);
+        let target = eye + Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, -1.0);
+        let viewport = match case % orthographic {
+            0 => Viewport::Orthographic {
+                height: [1e-3, 1.0, 50.0][rng.usize(0..3)],
+            },
+            _ => Viewport::Perspective {
+                fov_y_deg: fovs[rng.usize(0..fovs.len())],
+            },
+        };
+        (eye, target, viewport)
+    }
+
     fn on_ray(view: &View, x: f32, y: f32, t: f64) -> Vec3 {
         let (x, y) = (f64::from(x), f64::from(y));
         let origin = view.eye.as_dvec3()
@@ -706,18 +730,8 @@ mod tests {
         let mut rng = fastrand::Rng::with_seed(11);
         let (mut covered, mut boxes, mut in_nodes) = (0u64, 0u64, 0u64);
         for case in 0..400 {
-            let far = [0.0, 1e3, 3e5][case % 3];
-            let eye = Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5) * 4.0
-                + Vec3::splat(far);
-            let target = eye + Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, -1.0);
-            let viewport = match case % 6 {
-                0 => Viewport::Orthographic {
-                    height: [1e-3, 1.0, 50.0][rng.usize(0..3)],
-                },
-                _ => Viewport::Perspective {
-                    fov_y_deg: [0.05, 0.5, 10.0, 60.0, 120.0, 170.0][rng.usize(0..6)],
-                },
-            };
+            let fovs = [0.05, 0.5, 10.0, 60.0, 120.0, 170.0];
+            let (eye, target, viewport) = random_look(&mut rng, case, 6, &fovs);
             let size = match case % 4 {
                 0 => (16384, 9),
                 1 => (9, 16384),
@@ -951,18 +965,7 @@ mod tests {
         let mut rng = fastrand::Rng::with_seed(31);
         let (mut checked, mut some, mut in_lanes, mut fallback) = (0, 0, 0, 0);
         for case in 0..2_000 {
-            let far = [0.0, 1e3, 3e5][case % 3];
-            let eye = Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5) * 4.0
-                + Vec3::splat(far);
-            let target = eye + Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, -1.0);
-            let viewport = match case % 4 {
-                0 => Viewport::Orthographic {
-                    height: [1e-3, 1.0, 50.0][rng.usize(0..3)],
-                },
-                _ => Viewport::Perspective {
-                    fov_y_deg: [0.5, 10.0, 60.0, 170.0][rng.usize(0..4)],
-                },
-            };
+            let (eye, target, viewport) = random_look(&mut rng, case, 4, &[0.5, 10.0, 60.0, 170.0]);
             let size = (rng.u32(1..3000), rng.u32(1..3000));
             let near = [1e-3, 0.1, 1.0][rng.usize(0..3)];
             // One case in ten: an axis-aligned orthographic view of boxes
