@@ -74,6 +74,10 @@ mod sealed {
         fn ge(self, o: Self) -> u8;
         fn le(self, o: Self) -> u8;
         fn eq(self, o: Self) -> u8;
+        /// Lane `l` of `a` where bit `l` of `mask` is set, of `b` elsewhere.
+        fn select(mask: u8, a: Self, b: Self) -> Self;
+        /// Lane `l` is lane `from[l]` (below 8) of `self`.
+        fn permute(self, from: [u32; 8]) -> Self;
     }
 }
 
@@ -129,6 +133,25 @@ impl sealed::Ops for Portable {
     #[inline(always)]
     fn eq(self, o: Self) -> u8 {
         self.simd_eq(o).to_bitmask() as u8
+    }
+    #[inline(always)]
+    fn select(mask: u8, a: Self, b: Self) -> Self {
+        let (a, mut b) = (a.to_array(), b.to_array());
+        for l in 0..8 {
+            if mask & (1 << l) != 0 {
+                b[l] = a[l];
+            }
+        }
+        Self::from_array(b)
+    }
+    #[inline(always)]
+    fn permute(self, from: [u32; 8]) -> Self {
+        let v = self.to_array();
+        let mut out = [0.0; 8];
+        for (o, &f) in out.iter_mut().zip(&from) {
+            *o = v[f as usize & 7];
+        }
+        Self::from_array(out)
     }
 }
 
@@ -243,6 +266,22 @@ mod avx2_lanes {
         #[inline(always)]
         fn eq(self, o: Self) -> u8 {
             avx!(_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(self.0, o.0))) as u8
+        }
+        #[inline(always)]
+        fn select(mask: u8, a: Self, b: Self) -> Self {
+            // Lane `l` of the blend mask is all ones where bit `l` is set.
+            avx!({
+                let bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+                let set = _mm256_and_si256(_mm256_set1_epi32(i32::from(mask)), bits);
+                let lanes = _mm256_castsi256_ps(_mm256_cmpeq_epi32(set, bits));
+                Avx2(_mm256_blendv_ps(b.0, a.0, lanes))
+            })
+        }
+        #[inline(always)]
+        fn permute(self, from: [u32; 8]) -> Self {
+            // SAFETY: `[u32; 8]` and `__m256i` are both 32 bytes.
+            let from = unsafe { std::mem::transmute::<[u32; 8], __m256i>(from) };
+            Avx2(avx!(_mm256_permutevar8x32_ps(self.0, from)))
         }
     }
 }

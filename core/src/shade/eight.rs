@@ -35,13 +35,13 @@ impl<L: Lanes> V3<L> {
         }
     }
 
-    /// Eight vectors given axis by axis.
+    /// Eight vectors given axis by axis, lane `l` taken from column `from[l]`.
     #[inline(always)]
-    fn of([x, y, z]: &[[f32; 8]; 3]) -> Self {
+    fn of([x, y, z]: &[[f32; 8]; 3], from: [u32; 8]) -> Self {
         V3 {
-            x: L::from_array(*x),
-            y: L::from_array(*y),
-            z: L::from_array(*z),
+            x: L::from_array(*x).permute(from),
+            y: L::from_array(*y).permute(from),
+            z: L::from_array(*z).permute(from),
         }
     }
 
@@ -165,46 +165,42 @@ impl Shader<'_> {
         let interpolated = !mesh.normals.is_empty();
         debug_assert!(s.lanes != 0, "at least one lane to shade");
         let mut done = s.lanes;
-        // 1. What each lane's triangle brings (lanes without one repeat the
+        // 1. What each lane's triangle brings (lanes without one take the
         // first that has one, so that every lane computes on real values).
+        // Neighbouring samples mostly hold one triangle: each run of lanes
+        // holding one has its records read once, into column `d` of
+        // `records` (per vertex `k` and axis `a`: corner `[k][a]`, vertex
+        // normal `[3 + k][a]`; base colour `[6]`, emission `[7]`), and lane
+        // `l` takes column `run[l]` by a lane permute.
         let first = s.ids[done.trailing_zeros() as usize];
-        // Gathered straight into lanes: per vertex `k` and axis `a`, lane `l`
-        // at `[k][a][l]` (no transposes of 8 × Vec3 afterwards).
-        let mut corners = [[[0.0f32; 8]; 3]; 3];
-        let mut vertex_normals = [[[0.0f32; 8]; 3]; 3];
-        let mut base = [[0.0f32; 8]; 3];
-        let mut emissive = [[0.0f32; 8]; 3];
-        // The lane that last gathered, its triangle, and whether one of
-        // that triangle's vertex normals is zero (the scalar path's case).
-        let mut previous: Option<(usize, usize, bool)> = None;
+        let mut records = [[[0.0f32; 8]; 3]; 8];
+        let mut run = [0u32; 8];
+        // The last run's triangle and whether one of its vertex normals is
+        // zero (the scalar path's case: its lanes go there).
+        let mut last: Option<(u32, bool)> = None;
+        let mut runs = 0;
         for l in 0..8 {
             let id = if done & (1 << l) != 0 {
                 s.ids[l]
             } else {
                 first
-            } as usize;
-            // Neighbouring samples mostly hold one triangle: its records are
-            // the previous lane's (no second gather of the same ones).
-            if let Some((_, last, zero_normal)) = previous.filter(|p| p.0 == id) {
-                for a in 0..3 {
-                    for k in 0..3 {
-                        corners[k][a][l] = corners[k][a][last];
-                        vertex_normals[k][a][l] = vertex_normals[k][a][last];
-                    }
-                    (base[a][l], emissive[a][l]) = (base[a][last], emissive[a][last]);
-                }
+            };
+            if let Some((_, zero_normal)) = last.filter(|&(previous, _)| previous == id) {
+                run[l] = runs - 1;
                 if zero_normal {
                     done &= !(1 << l);
                 }
                 continue;
             }
-            let (p, vertices) = prepared.corners_and_vertices(id as u32);
-            let material = &prepared.scene.materials[self.material_of(id as u32) as usize];
+            let d = runs as usize;
+            let (p, vertices) = prepared.corners_and_vertices(id);
+            let material = &prepared.scene.materials[self.material_of(id) as usize];
             for a in 0..3 {
                 for k in 0..3 {
-                    corners[k][a][l] = p[k][a];
+                    records[k][a][d] = p[k][a];
                 }
-                (base[a][l], emissive[a][l]) = (material.base_color[a], material.emissive[a]);
+                records[6][a][d] = material.base_color[a];
+                records[7][a][d] = material.emissive[a];
             }
             let mut zero_normal = false;
             if interpolated {
@@ -212,16 +208,21 @@ impl Shader<'_> {
                     let n = mesh.normals[v as usize];
                     zero_normal |= n == Vec3::ZERO;
                     for a in 0..3 {
-                        vertex_normals[k][a][l] = n[a];
+                        records[3 + k][a][d] = n[a];
                     }
                 }
                 if zero_normal {
                     done &= !(1 << l);
                 }
             }
-            previous = Some((id, l, zero_normal));
+            (run[l], runs) = (runs, runs + 1);
+            last = Some((id, zero_normal));
         }
-        let [p0, p1, p2] = corners.map(|c| V3::<L>::of(&c));
+        let [p0, p1, p2] = [
+            V3::<L>::of(&records[0], run),
+            V3::<L>::of(&records[1], run),
+            V3::<L>::of(&records[2], run),
+        ];
 
         // 2. The ray through each sample (`View::origin`, `View::direction`).
         let view = self.view;
@@ -242,10 +243,7 @@ impl Shader<'_> {
         let (facing, ok) = normal.normalized();
         done &= ok;
         let flip = facing.dot(dir).gt(L::splat(0.0));
-        let toward = L::from_array(std::array::from_fn(|l| match flip & (1 << l) {
-            0 => 1.0,
-            _ => -1.0,
-        }));
+        let toward = L::select(flip, L::splat(-1.0), L::splat(1.0));
         let normal = if interpolated {
             // The §3.2 barycentrics `V_i / ΣV` (`barycentrics`).
             let q = [p0.sub(origin), p1.sub(origin), p2.sub(origin)];
@@ -254,9 +252,9 @@ impl Shader<'_> {
             let v2 = q[0].cross(q[1]).dot(dir);
             let total = v0 + v1 + v2;
             done &= !total.eq(L::splat(0.0)) & finite(total);
-            let n0 = V3::<L>::of(&vertex_normals[0]).scale(v0 / total);
-            let n1 = V3::<L>::of(&vertex_normals[1]).scale(v1 / total);
-            let n2 = V3::<L>::of(&vertex_normals[2]).scale(v2 / total);
+            let n0 = V3::<L>::of(&records[3], run).scale(v0 / total);
+            let n1 = V3::<L>::of(&records[4], run).scale(v1 / total);
+            let n2 = V3::<L>::of(&records[5], run).scale(v2 / total);
             let n = n0.add(n1).add(n2);
             let (n, ok) = n.normalized();
             done &= ok;
@@ -289,7 +287,7 @@ impl Shader<'_> {
             done &= lambert.eq(lambert);
             lit = lit.add(V3::splat(color).scale(lambert.max(zero)));
         }
-        let (base, emissive) = (V3::<L>::of(&base), V3::<L>::of(&emissive));
+        let (base, emissive) = (V3::<L>::of(&records[6], run), V3::<L>::of(&records[7], run));
         let r = (base.x * ambient(lit.x) + emissive.x).to_array();
         let g = (base.y * ambient(lit.y) + emissive.y).to_array();
         let b = (base.z * ambient(lit.z) + emissive.z).to_array();
