@@ -3,6 +3,8 @@
 
 use glam::Vec3;
 
+use crate::simd::Lanes;
+
 /// Background colour (sRGB).
 pub const BACKGROUND_COLOR: [u8; 4] = [24, 24, 28, 255];
 
@@ -132,19 +134,28 @@ pub fn encode_rgb(c: Vec3) -> [u8; 4] {
     [table.encode(c.x), table.encode(c.y), table.encode(c.z), 255]
 }
 
-/// [`encode_rgb`] of eight colours given channel by channel (what lanes
-/// hold): one table lookup, then 24 independent encodes.
-#[inline]
-pub fn encode_rgb_eight([r, g, b]: &[[f32; 8]; 3]) -> [[u8; 4]; 8] {
+/// [`encode_rgb`] of eight colours in lanes, channel by channel (red,
+/// green, blue): the clamp and the bucket index in lanes (`v ≥ 1` → 1, then
+/// `v · 4096` truncated, a NaN or negative lane to bucket 0, as the scalar
+/// `as usize` gives), then per lane the bucket's byte.
+#[inline(always)]
+pub(crate) fn encode_rgb_eight<L: Lanes>(channels: [L; 3]) -> [[u8; 4]; 8] {
     let table = srgb_table();
-    std::array::from_fn(|l| {
-        [
-            table.encode(r[l]),
-            table.encode(g[l]),
-            table.encode(b[l]),
-            255,
-        ]
-    })
+    let one = L::splat(1.0);
+    let mut out = [[0, 0, 0, 255]; 8];
+    for (c, v) in channels.into_iter().enumerate() {
+        let v = L::select(v.ge(one), one, v);
+        // `maxps` gives its second operand, 0, for a NaN lane.
+        let at = (v * L::splat(SRGB_BUCKETS as f32))
+            .max(L::splat(0.0))
+            .truncate();
+        let v = v.to_array();
+        for l in 0..8 {
+            let bucket = &table.buckets[at[l] as usize];
+            out[l][c] = bucket.first + u8::from(v[l] >= bucket.next);
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -187,19 +198,33 @@ mod tests {
                 v.to_bits()
             );
         }
-        // Eight at a time, each channel from its own place in the list.
+        // Eight at a time in lanes, portable and dispatched (AVX2 where the
+        // CPU has it), each channel from its own place in the list.
         let mut groups = 0;
         for chunk in values.chunks_exact(24) {
             let channels: [[f32; 8]; 3] =
                 std::array::from_fn(|c| std::array::from_fn(|l| chunk[8 * c + l]));
-            let eight = encode_rgb_eight(&channels);
-            for (l, rgba) in eight.iter().enumerate() {
-                let c = Vec3::new(channels[0][l], channels[1][l], channels[2][l]);
-                assert_eq!(*rgba, encode_rgb(c), "{c}");
+            for eight in [
+                encode_group_on::<crate::simd::Portable>(&channels),
+                encode_group(&channels),
+            ] {
+                for (l, rgba) in eight.iter().enumerate() {
+                    let c = Vec3::new(channels[0][l], channels[1][l], channels[2][l]);
+                    assert_eq!(*rgba, encode_rgb(c), "{c}");
+                }
             }
             groups += 1;
         }
         assert_eq!(groups, values.len() / 24);
+    }
+
+    crate::simd::dispatch! {
+        fn encode_group<>(channels: &[[f32; 8]; 3]) -> [[u8; 4]; 8] => encode_group_on
+    }
+
+    #[inline(always)]
+    fn encode_group_on<L: Lanes>([r, g, b]: &[[f32; 8]; 3]) -> [[u8; 4]; 8] {
+        encode_rgb_eight([L::from_array(*r), L::from_array(*g), L::from_array(*b)])
     }
 
     #[test]

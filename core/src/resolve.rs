@@ -371,7 +371,7 @@ fn shade_single_on<L: Lanes>(
                 0 => ([[0; 4]; 8], 0),
                 _ => {
                     let (linear, done) = shader.shade_eight::<L>(&eight);
-                    (encode_rgb_eight(&linear), done)
+                    (encode_rgb_eight::<L>(linear), done)
                 }
             };
             totals.shading_samples += u64::from(done.count_ones());

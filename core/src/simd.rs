@@ -78,6 +78,9 @@ mod sealed {
         fn select(mask: u8, a: Self, b: Self) -> Self;
         /// Lane `l` is lane `from[l]` (below 8) of `self`.
         fn permute(self, from: [u32; 8]) -> Self;
+        /// Each lane truncated toward zero, as `f32 as u32` (for lanes in
+        /// `[0, 2³¹)`: the only ones callers pass).
+        fn truncate(self) -> [u32; 8];
     }
 }
 
@@ -152,6 +155,10 @@ impl sealed::Ops for Portable {
             *o = v[f as usize & 7];
         }
         Self::from_array(out)
+    }
+    #[inline(always)]
+    fn truncate(self) -> [u32; 8] {
+        self.to_array().map(|v| v as u32)
     }
 }
 
@@ -282,6 +289,12 @@ mod avx2_lanes {
             // SAFETY: `[u32; 8]` and `__m256i` are both 32 bytes.
             let from = unsafe { std::mem::transmute::<[u32; 8], __m256i>(from) };
             Avx2(avx!(_mm256_permutevar8x32_ps(self.0, from)))
+        }
+        #[inline(always)]
+        fn truncate(self) -> [u32; 8] {
+            let v = avx!(_mm256_cvttps_epi32(self.0));
+            // SAFETY: `__m256i` and `[u32; 8]` are both 32 bytes.
+            unsafe { std::mem::transmute::<__m256i, [u32; 8]>(v) }
         }
     }
 }

@@ -159,7 +159,7 @@ impl Shader<'_> {
     /// `s.lanes` that met none of the scalar path's special cases (see the
     /// module documentation).
     #[inline(always)]
-    pub(crate) fn shade_eight<L: Lanes>(&self, s: &EightSamples) -> ([[f32; 8]; 3], u8) {
+    pub(crate) fn shade_eight<L: Lanes>(&self, s: &EightSamples) -> ([L; 3], u8) {
         let prepared = self.scene;
         let mesh = &prepared.scene.mesh;
         let interpolated = !mesh.normals.is_empty();
@@ -179,14 +179,14 @@ impl Shader<'_> {
         // zero (the scalar path's case: its lanes go there).
         let mut last: Option<(u32, bool)> = None;
         let mut runs = 0;
-        for l in 0..8 {
+        for (l, lane_run) in run.iter_mut().enumerate() {
             let id = if done & (1 << l) != 0 {
                 s.ids[l]
             } else {
                 first
             };
             if let Some((_, zero_normal)) = last.filter(|&(previous, _)| previous == id) {
-                run[l] = runs - 1;
+                *lane_run = runs - 1;
                 if zero_normal {
                     done &= !(1 << l);
                 }
@@ -215,7 +215,7 @@ impl Shader<'_> {
                     done &= !(1 << l);
                 }
             }
-            (run[l], runs) = (runs, runs + 1);
+            (*lane_run, runs) = (runs, runs + 1);
             last = Some((id, zero_normal));
         }
         let [p0, p1, p2] = [
@@ -288,9 +288,9 @@ impl Shader<'_> {
             lit = lit.add(V3::splat(color).scale(lambert.max(zero)));
         }
         let (base, emissive) = (V3::<L>::of(&records[6], run), V3::<L>::of(&records[7], run));
-        let r = (base.x * ambient(lit.x) + emissive.x).to_array();
-        let g = (base.y * ambient(lit.y) + emissive.y).to_array();
-        let b = (base.z * ambient(lit.z) + emissive.z).to_array();
+        let r = base.x * ambient(lit.x) + emissive.x;
+        let g = base.y * ambient(lit.y) + emissive.y;
+        let b = base.z * ambient(lit.z) + emissive.z;
         ([r, g, b], done)
     }
 }
