@@ -130,10 +130,9 @@ fn resolve_tile(tile: &TileBuffer, out: &mut TilePlanes) -> TileTotals {
         out.triangle_id[r].copy_from_slice(&tile.triangle_id[row.clone()]);
         let evals = &tile.edge_evals[row.clone()];
         out.edge_evals[r].copy_from_slice(evals);
-        for &e in evals {
-            (edge_evaluations, max_edge_evals) =
-                (edge_evaluations + u64::from(e), max_edge_evals.max(e));
-        }
+        // Two plain reductions over the row (in L1): each vectorizes.
+        edge_evaluations += evals.iter().map(|&e| u64::from(e)).sum::<u64>();
+        max_edge_evals = max_edge_evals.max(evals.iter().copied().max().unwrap_or(0));
         let writes = &mut *out.coverage_writes[r];
         writes.copy_from_slice(&tile.coverage_writes[row.clone()]);
         histogram += CoverageHistogram::of(writes);

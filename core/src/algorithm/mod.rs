@@ -16,6 +16,7 @@
 //! | `gpu-2dr`, `gpu-2dr-homogeneous`, `gpu-3dr` | wgpu compute: setup kernel, one thread per triangle | bounding box |
 //! | `gpu-3dr-binned` | wgpu compute: setup → bin → prefix sum → a workgroup per tile | tile tests, then per pixel |
 
+mod gate;
 #[cfg(feature = "gpu")]
 mod gpu_compute;
 mod raycast;
@@ -378,10 +379,11 @@ impl<'a> TileContext<'a> {
     /// Renders every tile of `rects` with `render` (given the tile's index, its
     /// worker's `W`, and its sample buffers) and resolves it into `fb`'s planes;
     /// returns the finished tiles in `rects`' order. One worker per thread of
-    /// the pool takes the next tile from a shared counter until none is left,
-    /// keeping its tile buffers and its `W` (a traversal's leaf cache) from one
-    /// tile to the next: made once per worker and frame, however the pool is
-    /// split. (rayon's `map_init` makes them once per split, and a pool of more
+    /// the pool, at most one per core at once (a [`gate::Gate`]), takes the
+    /// next tile from a shared counter until none is left, keeping its tile
+    /// buffers and its `W` (a traversal's leaf cache) from one tile to the
+    /// next: made once per worker and frame, however the pool is split.
+    /// (rayon's `map_init` makes them once per split, and a pool of more
     /// threads than cores splits a frame nearly once per tile.)
     pub fn run_tiles<W: Default, R: Default + Send>(
         &self,
@@ -396,7 +398,12 @@ impl<'a> TileContext<'a> {
             .map(|p| Mutex::new(Some(p)))
             .collect();
         let next = AtomicUsize::new(0);
+        let workers = rayon::current_num_threads().min(planes.len());
+        let gate = gate::Gate::new(gate::cores());
         let worker = |_| {
+            // No more workers render at once than there are cores; the rest
+            // wait here, and find no tile left when let in.
+            let _place = gate.enter();
             let (mut cache, mut mine) = (None, W::default());
             let mut done = Vec::new();
             loop {
@@ -416,7 +423,7 @@ impl<'a> TileContext<'a> {
                 ));
             }
         };
-        let mut done: Vec<_> = (0..rayon::current_num_threads().min(planes.len()))
+        let mut done: Vec<_> = (0..workers)
             .into_par_iter()
             .with_max_len(1)
             .flat_map_iter(worker)
