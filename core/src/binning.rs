@@ -138,10 +138,25 @@ fn sample_rows<L: Lanes, T: Coverage>(
         for count in &mut tile.edge_evals[i..i + n as usize] {
             *count += 1;
         }
-        tri.sample_run::<L>(r.x0 as f32 + 0.5, y as f32 + 0.5, n, |k, w| {
-            covered += 1;
-            tile.write(i + k as usize, w, id);
-        });
+        let (x0, y) = (r.x0 as f32 + 0.5, y as f32 + 0.5);
+        // Runs shorter than a group (small triangles) are written sample by
+        // sample: cheaper there than a group's loads and blends.
+        if T::OWN_SAMPLE_RUN || n < 8 {
+            tri.sample_run::<L>(x0, y, n, |k, w| {
+                covered += 1;
+                tile.write(i + k as usize, w, id);
+            });
+            continue;
+        }
+        // Eight samples at a time, written (depth-tested) eight at a time.
+        for k in (0..n).step_by(8) {
+            let active = first_lanes((n - k) as usize);
+            let (mask, w) = tri.sample8::<L>(x0 + k as f32, y, active);
+            if mask != 0 {
+                covered += mask.count_ones();
+                tile.write_eight::<L>(i + k as usize, mask, &w, id);
+            }
+        }
     }
     covered
 }

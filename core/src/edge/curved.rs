@@ -252,6 +252,8 @@ impl CurvedTriangle {
 }
 
 impl Coverage for CurvedTriangle {
+    const OWN_SAMPLE_RUN: bool = true;
+
     /// `V_i = n_i·d(x, y)` for the three edges, the tie rule on `V_i = 0`, then
     /// the distance.
     #[inline]

@@ -160,6 +160,11 @@ pub enum BlockTest {
 /// the single decision all algorithms of a family share: edge values in one fixed
 /// operation order, the tie rule, then depth.
 pub trait Coverage {
+    /// Whether [`Coverage::sample_run`] is this type's own walk along the
+    /// row (curved edges' incremental evaluation) rather than groups of
+    /// [`Coverage::sample8`], which callers may then take group by group.
+    const OWN_SAMPLE_RUN: bool = false;
+
     /// Coverage and depth of the sample at `(x, y)`.
     fn sample(&self, x: f32, y: f32) -> Option<f32>;
 
@@ -231,6 +236,7 @@ pub trait Coverage {
 /// A reference reads as what it refers to (what [`Stored::bind`] gives the
 /// set-up triangles that are their own coverage).
 impl<C: Coverage> Coverage for &C {
+    const OWN_SAMPLE_RUN: bool = C::OWN_SAMPLE_RUN;
     #[inline(always)]
     fn sample(&self, x: f32, y: f32) -> Option<f32> {
         (**self).sample(x, y)
