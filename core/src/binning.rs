@@ -298,6 +298,12 @@ fn sample_pattern<L: Lanes, T: Coverage>(
                 }
                 let mut mask = u32::from(mask) & ((1 << lanes) - 1);
                 covered += mask.count_ones();
+                if count == 1 && !masked && lanes == 8 {
+                    // One position per pixel: lane `l` is pixel `q + l` (a
+                    // whole group; partial ones, small blocks, one by one).
+                    tile.write_eight::<L>(i + q, mask as u8, &w, id);
+                    continue;
+                }
                 while mask != 0 {
                     let l = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
