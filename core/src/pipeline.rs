@@ -203,14 +203,20 @@ impl ComputeKind {
 
 /// `3dr-full`'s frustum side and split size in pixels: measured, not the
 /// paper's 256² split down to 8². With binning and early-z at the leaves, a
-/// frustum rarely gains from splitting below 32², and frusta of 128² keep
-/// the hierarchical w-buffer's answers local; on the five benchmark scenes
-/// (1920×1080, two threads, `compare --algorithms 3dr-full,3dr-brute
-/// --oracles 'frustum=128,split=32;frustum=64,split=16;…'`, three runs) this
-/// setting took 0.51–0.82× the paper's time: the best geometric mean of the
-/// settings tried (frusta of 32² to 256², split sizes 8 to 64).
-/// `--oracles frustum=256,split=8` restores the paper's.
-pub(crate) const FULL_FRUSTUM: u32 = 128;
+/// frustum rarely gains from splitting below 32². On the five benchmark
+/// scenes (1920×1080, two threads, `compare --algorithms 3dr-full,3dr-brute
+/// --oracles 'frustum=128,split=32;frustum=64,split=16;…'`, three runs) 128²
+/// split to 32² first took 0.51–0.82× the paper's time, the best geometric
+/// mean of frusta of 32² to 256² and split sizes 8 to 64. Once tiles were
+/// depth-tested eight samples at a time, the frame around them (each tile's
+/// rows copied and shaded into the frame) cost more per tile than the
+/// traversal saved: 256² split to 32² then took 0.87–0.99× the time of
+/// 128² on every one of the five (`--oracles 'frustum=256,split=32;
+/// frustum=256,split=16;frustum=256,split=64;frustum=512,split=32'`, three
+/// runs; split to 64² was faster on `soup` and `sponza` but slower on the
+/// dragon and `teapots`). `--oracles frustum=256,split=8` restores the
+/// paper's.
+pub(crate) const FULL_FRUSTUM: u32 = 256;
 /// See [`FULL_FRUSTUM`].
 pub(crate) const FULL_SPLIT: u32 = 32;
 

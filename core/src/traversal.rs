@@ -193,7 +193,7 @@ impl<L: Lanes> ChildTests<L> {
 /// A frustum: its pixels, the four side planes through their borders, and
 /// its centre ray — computed once when the frustum is made, not at every node
 /// it meets — and the hierarchical w-buffer's depths over its pixels, read
-/// again only when the buffer has changed (a 128² frustum spans 256 cells,
+/// again only when the buffer has changed (a 256² frustum spans 1,024 cells,
 /// and meets many nodes between two leaves).
 #[derive(Clone, Debug)]
 struct Frustum {
