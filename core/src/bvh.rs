@@ -181,64 +181,79 @@ impl SceneBvh {
         visited
     }
 
-    /// [`SceneBvh::walk`] for a packet of up to [`PACKET`] rays (absent lanes
-    /// take no part): a node is entered when any ray may meet it before its
-    /// own culling distance, so every ray reaches every node its single walk
-    /// would (front to back in the first present ray's order). Rays from one
-    /// origin (every perspective and spherical view) are tested together by
-    /// [`PacketInterval`], one 8-lane test per node for the whole packet;
-    /// others ray by ray. `leaf(slot, cull)` is called for each primitive slot
-    /// of every leaf the packet reaches, updates each lane's culling distance
-    /// in `cull` and says whether it changed any. Returns the number of nodes
-    /// whose children were tested (once per node, for the packet), and adds
-    /// their indices to `entered` when given (a render's trace). The slab tests run on lanes `L`
-    /// (the caller's instruction set, see [`crate::simd`]; inlined into it).
+    /// [`SceneBvh::walk`] for a packet of `G` groups of up to [`PACKET`] rays
+    /// each (absent lanes take no part): a node is entered when any ray may
+    /// meet it before its own culling distance, so every ray reaches every
+    /// node its single walk would (front to back in the first present ray's
+    /// order). The groups share each node's read and decode, and are tested
+    /// each on its own: rays from one origin (every perspective and
+    /// spherical view) by the group's [`PacketInterval`] against its own
+    /// largest culling distance, one 8-lane test per node and group; others
+    /// ray by ray. So a packet whose groups diverge (one done behind a near
+    /// surface, another still open to the background) culls as its groups
+    /// would alone. `leaf(slot, cull)` is called for each primitive slot of
+    /// every leaf the packet reaches, updates each lane's culling distance in
+    /// `cull[group]` and says whether it changed any. Returns the number of
+    /// nodes whose children were tested (once per node, for the packet), and
+    /// adds their indices to `entered` when given (a render's trace). The slab
+    /// tests run on lanes `L` (the caller's instruction set, see
+    /// [`crate::simd`]; inlined into it).
     #[inline(always)]
-    pub fn walk_packet<L: Lanes>(
+    pub fn walk_packet<L: Lanes, const G: usize>(
         &self,
-        rays: PacketRays,
+        rays: &[PacketRays; G],
         mut entered: Option<&mut Vec<u32>>,
-        mut leaf: impl FnMut(u32, &mut [f32; PACKET]) -> bool,
+        mut leaf: impl FnMut(u32, &mut [[f32; PACKET]; G]) -> bool,
     ) -> u64 {
         if self.cwbvh.nodes.is_empty() {
             return 0;
         }
         // Loops, not `map` closures: this is lane code (see `crate::simd`).
         // Absent lanes never enter a node.
-        let (mut slabs, mut cull) = ([None; PACKET], [f32::NEG_INFINITY; PACKET]);
-        let (interval, first) = match rays {
-            PacketRays::OneOrigin {
-                origin,
-                directions,
-                present,
-            } => {
-                if present == 0 {
-                    return 0;
-                }
-                for (l, c) in cull.iter_mut().enumerate() {
-                    if present >> l & 1 == 1 {
-                        *c = f32::INFINITY;
+        let mut slabs = [[None; PACKET]; G];
+        let mut cull = [[f32::NEG_INFINITY; PACKET]; G];
+        let mut intervals = [None; G];
+        let mut first = None;
+        for g in 0..G {
+            match rays[g] {
+                PacketRays::OneOrigin {
+                    origin,
+                    directions,
+                    present,
+                } => {
+                    if present == 0 {
+                        continue;
                     }
-                }
-                let l = present.trailing_zeros() as usize;
-                let first = Vec3::new(directions[0][l], directions[1][l], directions[2][l]);
-                let interval = PacketInterval::of_directions::<L>(origin, &directions, present);
-                (Some(interval), first)
-            }
-            PacketRays::Rays(rays) => {
-                let Some(&(_, first)) = rays.iter().flatten().next() else {
-                    return 0;
-                };
-                for l in 0..PACKET {
-                    if let Some((origin, dir)) = rays[l] {
-                        (slabs[l], cull[l]) = (Some(SlabRay::new(origin, dir)), f32::INFINITY);
+                    for (l, c) in cull[g].iter_mut().enumerate() {
+                        if present >> l & 1 == 1 {
+                            *c = f32::INFINITY;
+                        }
                     }
+                    let l = present.trailing_zeros() as usize;
+                    let d = Vec3::new(directions[0][l], directions[1][l], directions[2][l]);
+                    first = first.or(Some(d));
+                    let interval = PacketInterval::of_directions::<L>(origin, &directions, present);
+                    intervals[g] = Some(interval);
                 }
-                (PacketInterval::of(&slabs), first)
+                PacketRays::Rays(rays) => {
+                    for l in 0..PACKET {
+                        if let Some((origin, dir)) = rays[l] {
+                            slabs[g][l] = Some(SlabRay::new(origin, dir));
+                            cull[g][l] = f32::INFINITY;
+                            first = first.or(Some(dir));
+                        }
+                    }
+                    intervals[g] = PacketInterval::of(&slabs[g]);
+                }
             }
+        }
+        let Some(first) = first else {
+            return 0;
         };
-        // The packet's largest culling distance, renewed after each leaf.
-        let mut tmax = f32::INFINITY;
+        // Each group's largest culling distance, renewed after each leaf
+        // (−∞: a group without rays).
+        let mut tmax = [f32::NEG_INFINITY; G];
+        largest_per_group(&cull, &mut tmax);
         let mut visited = 0u64;
         let bvh = &self.cwbvh;
         let mut state = bvh.new_traversal(Vec3A::from(first));
@@ -253,33 +268,47 @@ impl SceneBvh {
                     entered.push(node_index(bvh, node) as u32);
                 }
                 let boxes = &Children::<L>::decode(node);
-                let hits = match &interval {
-                    Some(interval) => interval.hits::<L>(boxes, tmax),
-                    // A loop, not a closure: lane code must be inlined (see `crate::simd`).
-                    None => {
-                        let mut hits = 0;
-                        for (slab, &tmax) in slabs.iter().zip(&cull) {
-                            if let Some(slab) = slab {
-                                hits |= slab.hits8::<L>(boxes, tmax);
-                            }
-                        }
-                        hits
+                let mut hits = 0;
+                for g in 0..G {
+                    if tmax[g] == f32::NEG_INFINITY {
+                        continue;
                     }
-                };
+                    hits |= match &intervals[g] {
+                        Some(interval) => interval.hits::<L>(boxes, tmax[g]),
+                        // A loop, not a closure: lane code must be inlined (see `crate::simd`).
+                        None => {
+                            let mut hits = 0;
+                            for (slab, &tmax) in slabs[g].iter().zip(&cull[g]) {
+                                if let Some(slab) = slab {
+                                    hits |= slab.hits8::<L>(boxes, tmax);
+                                }
+                            }
+                            hits
+                        }
+                    };
+                }
                 child_mask(node, hits, state.oct_inv4)
             },
             {
-                // Most leaf triangles miss every ray: the packet's culling
-                // distance is renewed only when a hit moved one.
+                // Most leaf triangles miss every ray: the culling distances
+                // are renewed only when a hit moved one.
                 if leaf(state.primitive_id, &mut cull) {
-                    tmax = f32::NEG_INFINITY;
-                    for &c in &cull {
-                        tmax = tmax.max(c);
-                    }
+                    largest_per_group(&cull, &mut tmax);
                 }
             }
         );
         visited
+    }
+}
+
+/// Each group's largest culling distance.
+#[inline(always)]
+fn largest_per_group<const G: usize>(cull: &[[f32; PACKET]; G], tmax: &mut [f32; G]) {
+    for g in 0..G {
+        tmax[g] = f32::NEG_INFINITY;
+        for &c in &cull[g] {
+            tmax[g] = tmax[g].max(c);
+        }
     }
 }
 
@@ -419,7 +448,7 @@ impl PacketInterval {
     }
 
     /// The children (bit per slot) some ray of the packet may meet before
-    /// `tmax` (the largest culling distance of the packet).
+    /// `tmax` (the largest culling distance of its rays).
     #[inline(always)]
     fn hits<L: Lanes>(&self, boxes: &Children<L>, tmax: f32) -> u32 {
         // An array, not a `map` closure: lane code must be inlined (`crate::simd`).
@@ -447,7 +476,7 @@ impl PacketInterval {
     }
 }
 
-/// Rays walked together by [`SceneBvh::walk_packet`]: a 4×4 pixel block.
+/// Rays of one group of [`SceneBvh::walk_packet`]: a 4×4 pixel block.
 pub const PACKET: usize = 16;
 
 /// A ray prepared for slab tests.

@@ -347,27 +347,34 @@ pub(crate) fn first_lanes(n: usize) -> u8 {
     ((1u16 << n.min(8)) - 1) as u8
 }
 
-/// Defines `fn NAME<G: Bound, ..>(args) -> R` that runs `BODY::<L, G, ..>(args)`
+/// Defines `fn NAME<G: Bound, ..>(args) -> R` (or `fn NAME<G: Bound, ..; const
+/// C: Type, ..>`: const parameters after a semicolon) that runs
+/// `BODY::<L, G, .., C, ..>(args)`
 /// on the lanes [`isa`] picks: `BODY` (generic over `L: Lanes` first, and
 /// `#[inline(always)]` down to the lane operations, so that all of it is
 /// compiled into the AVX2 form) once with [`Avx2`] inside an
 /// `#[target_feature(enable = "avx2")]` function, once with [`Portable`].
 macro_rules! dispatch {
     ($(#[$meta:meta])* $vis:vis fn $name:ident<$($g:ident: $bound:path),*>($($arg:ident: $ty:ty),* $(,)?) -> $ret:ty => $body:ident) => {
+        $crate::simd::dispatch! {
+            $(#[$meta])* $vis fn $name<$($g: $bound),*; >($($arg: $ty),*) -> $ret => $body
+        }
+    };
+    ($(#[$meta:meta])* $vis:vis fn $name:ident<$($g:ident: $bound:path),*; $(const $c:ident: $cty:ty),*>($($arg:ident: $ty:ty),* $(,)?) -> $ret:ty => $body:ident) => {
         $(#[$meta])*
-        $vis fn $name<$($g: $bound),*>($($arg: $ty),*) -> $ret {
+        $vis fn $name<$($g: $bound,)* $(const $c: $cty),*>($($arg: $ty),*) -> $ret {
             #[cfg(target_arch = "x86_64")]
             {
                 #[target_feature(enable = "avx2")]
-                fn on_avx2<$($g: $bound),*>($($arg: $ty),*) -> $ret {
-                    $body::<$crate::simd::Avx2, $($g),*>($($arg),*)
+                fn on_avx2<$($g: $bound,)* $(const $c: $cty),*>($($arg: $ty),*) -> $ret {
+                    $body::<$crate::simd::Avx2, $($g,)* $($c),*>($($arg),*)
                 }
                 if $crate::simd::avx2() {
                     // SAFETY: `avx2()` found that this CPU has AVX2.
-                    return unsafe { on_avx2($($arg),*) };
+                    return unsafe { on_avx2::<$($g,)* $($c),*>($($arg),*) };
                 }
             }
-            $body::<$crate::simd::Portable, $($g),*>($($arg),*)
+            $body::<$crate::simd::Portable, $($g,)* $($c),*>($($arg),*)
         }
     };
 }

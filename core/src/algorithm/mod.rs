@@ -126,25 +126,28 @@ pub(crate) fn run(
                 Triangle3D::setup,
             )
         }
-        Pipeline::Rays if view.sphere.is_some() => raycast::render_raycast(
+        Pipeline::Rays { packet } if view.sphere.is_some() => raycast::render_raycast(
             scene,
             context,
+            packet,
             fb,
             stats,
             (),
             setup3d::one_by_one(CurvedTriangle::setup),
         ),
-        Pipeline::Rays if f64 => raycast::render_raycast(
+        Pipeline::Rays { packet } if f64 => raycast::render_raycast(
             scene,
             context,
+            packet,
             fb,
             stats,
             (),
             setup3d::one_by_one(Triangle3D64::setup),
         ),
-        Pipeline::Rays => raycast::render_raycast(
+        Pipeline::Rays { packet } => raycast::render_raycast(
             scene,
             context,
+            packet,
             fb,
             stats,
             setup3d::slot_shared_3d(scene, view),

@@ -26,13 +26,10 @@ use crate::trace::NodeOutcome;
 /// must still be visited.
 const CULL_MARGIN: f32 = 1.0 + 1.0 / 1024.0;
 
-/// Rows per parallel work item: one row of packets.
-const BAND_ROWS: u32 = BLOCK;
-
-/// Side of the pixel block whose rays walk the BVH as one packet.
+/// Side of the pixel block of one group of rays.
 const BLOCK: u32 = 4;
 const _: () = assert!((BLOCK * BLOCK) as usize == PACKET);
-/// 8-lane groups per packet.
+/// 8-lane halves of a group of rays.
 const HALVES: usize = PACKET.div_ceil(8);
 
 /// Casts one ray per stored sample; `setup` gives the same triangles the 3D
@@ -42,6 +39,7 @@ const HALVES: usize = PACKET.div_ceil(8);
 pub(crate) fn render_raycast<'a, T: Stored>(
     scene: &'a PreparedScene,
     context: &TileContext<'a>,
+    packet: u32,
     fb: &mut Framebuffer,
     stats: &mut Stats,
     shared: T::Shared<'a>,
@@ -59,9 +57,14 @@ pub(crate) fn render_raycast<'a, T: Stored>(
     // 2. Rays per sample, bands of rows in parallel, each resolved by its worker.
     let start = Instant::now();
     let mut pass = Pass::default();
-    let bands = fb.tile_rects(fb.width, BAND_ROWS);
+    let bands = fb.tile_rects(fb.width, packet);
     let done = context.run_tiles(&mut pass, fb, &bands, |_, (), tile| {
-        cast_band(scene, view, &setups, tile)
+        // One ray group, four, or sixteen to a packet (`RAY_PACKETS`).
+        match packet {
+            4 => cast_band::<T, 1>(scene, view, &setups, tile),
+            8 => cast_band::<T, 4>(scene, view, &setups, tile),
+            _ => cast_band::<T, 16>(scene, view, &setups, tile),
+        }
     });
     pass.add(done.into_iter().map(|finished| {
         stats.bvh_nodes_visited += finished.result;
@@ -75,7 +78,7 @@ pub(crate) fn render_raycast<'a, T: Stored>(
 
 simd::dispatch! {
     /// [`cast_band_on`] on the lanes of this CPU.
-    fn cast_band<T: Stored>(
+    fn cast_band<T: Stored; const G: usize>(
         scene: &PreparedScene,
         view: &View,
         setups: &Setups<T>,
@@ -84,18 +87,23 @@ simd::dispatch! {
 }
 
 /// Every stored sample of the band's pixels, cast as packets: the rays of one
-/// sample position through the sixteen pixels of a 4×4 block walk the BVH
-/// together ([`SceneBvh::walk_packet`](crate::bvh::SceneBvh::walk_packet)),
-/// each ray tested on its own against every triangle the packet reaches, so
-/// each finds exactly the hit its single walk would. Returns the BVH nodes
+/// sample position through the pixels of a square block of `G` groups of
+/// 4×4 rays (one band of packets: the band is as tall as a packet) walk the
+/// BVH together
+/// ([`SceneBvh::walk_packet`](crate::bvh::SceneBvh::walk_packet)), each
+/// ray tested on its own against every triangle the packet reaches, so each
+/// finds exactly the hit its single walk would. Returns the BVH nodes
 /// visited.
 #[inline(always)]
-fn cast_band_on<L: Lanes, T: Stored>(
+fn cast_band_on<L: Lanes, T: Stored, const G: usize>(
     scene: &PreparedScene,
     view: &View,
     setups: &Setups<T>,
     tile: &mut TileBuffer,
 ) -> u64 {
+    // Groups on a side of the packet, and its side in pixels.
+    let columns = G.isqrt() as u32;
+    let side = BLOCK * columns;
     let pattern = tile.pattern;
     let (stored, pixels) = (pattern.stored, tile.pixels);
     let mut nodes = 0;
@@ -104,66 +112,89 @@ fn cast_band_on<L: Lanes, T: Stored>(
     // Planar perspective views: every ray leaves the eye along
     // `View::direction`, computed here for the packet eight lanes at a time.
     let perspective = view.sphere.is_none() && !view.is_orthographic();
-    // Per lane: the BVH slot of each stored sample's triangle (CSAA).
-    let mut slots = [[0u32; 8]; PACKET];
-    for y in (tile.y0..tile.y1).step_by(BLOCK as usize) {
-        for x in (tile.x0..tile.x1).step_by(BLOCK as usize) {
-            // The block's pixels inside the tile (`None` beyond its edges) and
-            // their buffer indices. Plain loops, no closures: this is lane code
-            // (see `crate::simd`).
-            let (mut block, mut index) = ([None; PACKET], [0; PACKET]);
-            for l in 0..PACKET {
-                let (px, py) = (x + l as u32 % BLOCK, y + l as u32 / BLOCK);
-                if px < tile.x1 && py < tile.y1 {
-                    (block[l], index[l]) = (Some((px, py)), tile.index(px, py));
+    // Per group and lane: the BVH slot of each stored sample's triangle (CSAA).
+    let mut slots = [[[0u32; 8]; PACKET]; G];
+    for y in (tile.y0..tile.y1).step_by(side as usize) {
+        for x in (tile.x0..tile.x1).step_by(side as usize) {
+            // Each group's corner, its pixels inside the tile (`None` beyond
+            // its edges) and their buffer indices. Plain loops, no closures:
+            // this is lane code (see `crate::simd`).
+            let mut corner = [(0, 0); G];
+            let (mut block, mut index) = ([[None; PACKET]; G], [[0; PACKET]; G]);
+            for g in 0..G {
+                let (gx, gy) = (g as u32 % columns, g as u32 / columns);
+                corner[g] = (x + gx * BLOCK, y + gy * BLOCK);
+                for l in 0..PACKET {
+                    let (px, py) = (
+                        corner[g].0 + l as u32 % BLOCK,
+                        corner[g].1 + l as u32 / BLOCK,
+                    );
+                    if px < tile.x1 && py < tile.y1 {
+                        (block[g][l], index[g][l]) = (Some((px, py)), tile.index(px, py));
+                    }
                 }
             }
             for (s, &[ox, oy]) in pattern.positions[..stored].iter().enumerate() {
-                // The packet's rays (none outside the viewport, e.g. the
+                // Each group's rays (none outside the viewport, e.g. the
                 // parabolic disc: background) and their samples as two 8-lane
                 // tests (`cast`: bit per lane whose ray is cast).
-                let mut rays = [None; PACKET];
-                let (mut xs, mut ys, mut cast) = ([[0.0; 8]; HALVES], [[0.0; 8]; HALVES], 0u16);
-                for l in 0..PACKET {
-                    let Some((px, py)) = block[l] else {
-                        continue;
-                    };
-                    let (sx, sy) = (px as f32 + ox, py as f32 + oy);
-                    if !perspective {
-                        rays[l] = view.ray(sx, sy);
-                        if rays[l].is_none() {
+                let mut rays = [[None; PACKET]; G];
+                let mut xs = [[[0.0; 8]; HALVES]; G];
+                let mut ys = [[[0.0; 8]; HALVES]; G];
+                let mut cast = [0u16; G];
+                for g in 0..G {
+                    for l in 0..PACKET {
+                        let Some((px, py)) = block[g][l] else {
                             continue;
+                        };
+                        let (sx, sy) = (px as f32 + ox, py as f32 + oy);
+                        if !perspective {
+                            rays[g][l] = view.ray(sx, sy);
+                            if rays[g][l].is_none() {
+                                continue;
+                            }
                         }
+                        (xs[g][l / 8][l % 8], ys[g][l / 8][l % 8]) = (sx, sy);
+                        cast[g] |= 1 << l;
                     }
-                    (xs[l / 8][l % 8], ys[l / 8][l % 8]) = (sx, sy);
-                    cast |= 1 << l;
                 }
-                let packet = if perspective {
-                    PacketRays::OneOrigin {
-                        origin: view.eye,
-                        directions: directions_lanes::<L>(view, &xs, &ys),
-                        present: cast,
-                    }
-                } else {
-                    PacketRays::Rays(&rays)
-                };
-                let mut best = [(f32::INFINITY, BACKGROUND, 0u32); PACKET];
+                let mut packet = [PacketRays::Rays(&rays[0]); G];
+                for g in 0..G {
+                    packet[g] = if perspective {
+                        PacketRays::OneOrigin {
+                            origin: view.eye,
+                            directions: directions_lanes::<L>(view, &xs[g], &ys[g]),
+                            present: cast[g],
+                        }
+                    } else {
+                        PacketRays::Rays(&rays[g])
+                    };
+                }
+                let mut best = [[(f32::INFINITY, BACKGROUND, 0u32); PACKET]; G];
                 // Every ray of the packet tests every triangle it reaches
                 // whose screen box holds its pixel.
-                let (mut tested, mut covered) = ([0u32; PACKET], [0u32; PACKET]);
+                let (mut tested, mut covered) = ([[0u32; PACKET]; G], [[0u32; PACKET]; G]);
                 // See-through triangles leave fragments, as in the rasterizers'
                 // `TileBuffer::write`; the walk still culls beyond the nearest
                 // opaque hit, behind which no fragment shows.
                 let opacity = tile.opacity;
                 let fragments = &mut tile.fragments;
                 let entered = trace_nodes.as_mut();
-                nodes += scene.bvh.walk_packet::<L>(packet, entered, |k, cull| {
+                nodes += scene.bvh.walk_packet::<L, G>(&packet, entered, |k, cull| {
                     // The box first: most leaf triangles miss a packet's block.
                     let Some((rect, id)) = setups.boxes[k as usize].get() else {
                         return false;
                     };
-                    let inside = block_mask(rect, x, y);
-                    if cast & inside == 0 {
+                    if G > 1 && !overlaps(rect, x, y, side) {
+                        return false;
+                    }
+                    let mut inside = [0u16; G];
+                    let mut any = 0;
+                    for g in 0..G {
+                        inside[g] = cast[g] & block_mask(rect, corner[g].0, corner[g].1);
+                        any |= inside[g];
+                    }
+                    if any == 0 {
                         return false;
                     }
                     let Some(tri) = &setups.triangles[k as usize] else {
@@ -172,56 +203,63 @@ fn cast_band_on<L: Lanes, T: Stored>(
                     let tri = setups.bind(tri, k as usize, id);
                     let see_through = is_see_through(opacity, id);
                     let mut moved = false;
-                    for half in 0..HALVES {
-                        let active = ((cast & inside) >> (8 * half)) as u8;
-                        if active == 0 {
-                            continue;
-                        }
-                        let mut lanes = active;
-                        while lanes != 0 {
-                            tested[half * 8 + lanes.trailing_zeros() as usize] += 1;
-                            lanes &= lanes - 1;
-                        }
-                        let (mut hits, depth) = tri.sample_points8::<L>(xs[half], ys[half], active);
-                        while hits != 0 {
-                            let l = hits.trailing_zeros() as usize;
-                            hits &= hits - 1;
-                            let (w, lane) = (depth[l], half * 8 + l);
-                            covered[lane] += 1;
-                            if see_through {
-                                fragments.push(Fragment {
-                                    sample: (s * pixels + index[lane]) as u32,
-                                    w,
-                                    id,
-                                });
-                            } else if wins_depth_test(w, id, best[lane].0, best[lane].1) {
-                                best[lane] = (w, id, k);
-                                cull[lane] = w * CULL_MARGIN;
-                                moved = true;
+                    for g in 0..G {
+                        for half in 0..HALVES {
+                            let active = (inside[g] >> (8 * half)) as u8;
+                            if active == 0 {
+                                continue;
+                            }
+                            let mut lanes = active;
+                            while lanes != 0 {
+                                tested[g][half * 8 + lanes.trailing_zeros() as usize] += 1;
+                                lanes &= lanes - 1;
+                            }
+                            let (xs, ys) = (xs[g][half], ys[g][half]);
+                            let (mut hits, depth) = tri.sample_points8::<L>(xs, ys, active);
+                            while hits != 0 {
+                                let l = hits.trailing_zeros() as usize;
+                                hits &= hits - 1;
+                                let (w, lane) = (depth[l], half * 8 + l);
+                                covered[g][lane] += 1;
+                                if see_through {
+                                    fragments.push(Fragment {
+                                        sample: (s * pixels + index[g][lane]) as u32,
+                                        w,
+                                        id,
+                                    });
+                                } else if wins_depth_test(w, id, best[g][lane].0, best[g][lane].1) {
+                                    best[g][lane] = (w, id, k);
+                                    cull[g][lane] = w * CULL_MARGIN;
+                                    moved = true;
+                                }
                             }
                         }
                     }
                     moved
                 });
-                for l in 0..PACKET {
-                    if cast >> l & 1 == 0 {
-                        continue;
-                    }
-                    let (i, j) = (index[l], s * pixels + index[l]);
-                    tile.edge_evals[i] += tested[l];
-                    tile.coverage_writes[j] = covered[l];
-                    let (w, id, slot) = best[l];
-                    (tile.depth[j], tile.triangle_id[j]) = (w, id);
-                    if pattern.has_coverage_only() {
-                        slots[l][s] = slot;
+                for g in 0..G {
+                    for l in 0..PACKET {
+                        if cast[g] >> l & 1 == 0 {
+                            continue;
+                        }
+                        let (i, j) = (index[g][l], s * pixels + index[g][l]);
+                        tile.edge_evals[i] += tested[g][l];
+                        tile.coverage_writes[j] = covered[g][l];
+                        let (w, id, slot) = best[g][l];
+                        (tile.depth[j], tile.triangle_id[j]) = (w, id);
+                        if pattern.has_coverage_only() {
+                            slots[g][l][s] = slot;
+                        }
                     }
                 }
             }
             if pattern.has_coverage_only() {
-                for (l, p) in block.into_iter().enumerate() {
-                    if let Some(p) = p {
-                        stored_masks::<L, T>(setups, &slots[l], tile, p);
-                        nodes += lost_coverage::<L, T>(scene, view, setups, tile, p);
+                for g in 0..G {
+                    for (l, p) in block[g].into_iter().enumerate() {
+                        if let Some(p) = p {
+                            stored_masks::<L, T>(setups, &slots[g][l], tile, p);
+                            nodes += lost_coverage::<L, T>(scene, view, setups, tile, p);
+                        }
                     }
                 }
             }
@@ -363,6 +401,12 @@ fn lost_coverage<L: Lanes, T: Stored>(
     }
     tile.covered_any[i] = covered;
     nodes
+}
+
+/// Does `rect` share a pixel with the `side`² block at `(x, y)`?
+#[inline(always)]
+fn overlaps(rect: PixelRect, x: u32, y: u32, side: u32) -> bool {
+    rect.x0 < x + side && x < rect.x1 && rect.y0 < y + side && y < rect.y1
 }
 
 /// The lanes of the 4×4 block at `(x, y)` whose pixel lies in `rect` (bit
