@@ -301,7 +301,7 @@ pub const RAY_PACKETS: [u32; 3] = [4, 8, 16];
 
 /// `raycast`'s own packet side: four 4×4 groups share each node's read and
 /// decode, each tested against its own culling distance. At 1920×1080 on
-/// two threads this took 0.81–0.99× the time of 4×4 packets on `teapots`,
+/// two threads this took 0.80–1.00× the time of 4×4 packets on `teapots`,
 /// `bunny`, `soup`, the dragon and sponza, and 16×16 packets were slower on
 /// all five (`compare --oracles 'packet=4;packet=16' --algorithms raycast`).
 pub const RAY_PACKET: u32 = 8;
