@@ -16,7 +16,7 @@ use crate::edge::{Coverage, Stored};
 use crate::framebuffer::{BACKGROUND, Fragment, Framebuffer, TileBuffer, wins_depth_test};
 use crate::prepared::PreparedScene;
 use crate::prepared::is_see_through;
-use crate::simd::{self, Lanes};
+use crate::simd::{self, Lanes, Portable};
 use crate::stats::Stats;
 use crate::trace::NodeOutcome;
 
@@ -258,7 +258,7 @@ fn cast_band_on<L: Lanes, T: Stored, const G: usize>(
                     for (l, p) in block[g].into_iter().enumerate() {
                         if let Some(p) = p {
                             stored_masks::<L, T>(setups, &slots[g][l], tile, p);
-                            nodes += lost_coverage::<L, T>(scene, view, setups, tile, p);
+                            nodes += lost_coverage::<T>(scene, view, setups, tile, p);
                         }
                     }
                 }
@@ -362,7 +362,7 @@ fn coverage_mask<L: Lanes, T: Coverage>(tri: &T, pattern: &SamplePattern, x: u32
 /// positions the resolve reads it). One any-hit ray per such position; returns
 /// the BVH nodes visited.
 #[inline(always)]
-fn lost_coverage<L: Lanes, T: Stored>(
+fn lost_coverage<T: Stored>(
     scene: &PreparedScene,
     view: &View,
     setups: &Setups<T>,
@@ -390,7 +390,9 @@ fn lost_coverage<L: Lanes, T: Stored>(
         nodes += scene
             .bvh
             .walk(origin, direction, |k| match setups.get(k as usize) {
-                Some((_, _, tri)) if tri.covers8::<L>([xs; 8], [ys; 8]) & 1 == 1 => {
+                // Portable lanes (bit for bit the AVX2 ones): the walk's
+                // closure may not be inlined into the caller's AVX2 code.
+                Some((_, _, tri)) if tri.covers8::<Portable>([xs; 8], [ys; 8]) & 1 == 1 => {
                     covered |= 1 << c;
                     // Found: cull everything left.
                     f32::NEG_INFINITY
