@@ -126,6 +126,10 @@ impl ImageMap {
     /// `a/c − a₀/c₀ = (α − x₀·β)/c`, and the quotient rounds by `ε·|x|`. The
     /// bound doubles that and adds `8ε·|x|` so that the box's pixel bounds,
     /// rounded again from it, still hold every sample inside.
+    #[cfg_attr(
+        not(test),
+        expect(dead_code, reason = "the definition `points_eight` is tested against")
+    )]
     #[inline]
     pub(crate) fn point(&self, q: Vec3) -> ImagePoint {
         let setup_w = q.dot(self.forward);
@@ -343,9 +347,22 @@ impl ScreenBoxes {
     pub(crate) fn of(positions: &[Vec3], view: &View) -> ScreenBoxes {
         let map = view.sphere.is_none().then(|| ImageMap::new(view));
         let points = match &map {
-            Some(map) => (positions.par_iter())
-                .map(|&p| map.point(p - view.eye))
-                .collect(),
+            Some(map) => {
+                // Eight vertices at a time ([`points_eight`]); the last
+                // chunk's missing lanes repeat its last vertex and are cut.
+                let eights: Vec<[ImagePoint; 8]> = (positions.par_chunks(8))
+                    .map(|p| {
+                        points_eight(
+                            map,
+                            std::array::from_fn(|l| p[l.min(p.len() - 1)]),
+                            view.eye,
+                        )
+                    })
+                    .collect();
+                let mut points = eights.into_flattened();
+                points.truncate(positions.len());
+                points
+            }
             None => Vec::new(),
         };
         ScreenBoxes { map, points }
@@ -496,6 +513,86 @@ fn node_rects_eight_on<L: Lanes>(
 /// Eight triangles' projected vertices: x, y and rounding bound (as in
 /// [`ImagePoint::Projected`]), each per vertex and lane.
 type LanePoints = [[[f32; 8]; 3]; 3];
+
+simd::dispatch! {
+    /// [`ImageMap::point`] of eight vertices `p − eye`, one per lane.
+    fn points_eight<>(map: &ImageMap, p: [Vec3; 8], eye: Vec3) -> [ImagePoint; 8] => points_eight_on
+}
+
+/// [`ImageMap::point`] on lanes: the same IEEE operations in the same order
+/// (dot products as [`dot_lanes`], `f32::max` as [`max_f32`], no fused
+/// multiply-add), so each lane's point is the scalar one bit for bit.
+#[inline(always)]
+fn points_eight_on<L: Lanes>(map: &ImageMap, p: [Vec3; 8], eye: Vec3) -> [ImagePoint; 8] {
+    let (mut x, mut y, mut z) = ([0.0; 8], [0.0; 8], [0.0; 8]);
+    for l in 0..8 {
+        (x[l], y[l], z[l]) = (p[l].x, p[l].y, p[l].z);
+    }
+    let q = [
+        L::from_array(x) - L::splat(eye.x),
+        L::from_array(y) - L::splat(eye.y),
+        L::from_array(z) - L::splat(eye.z),
+    ];
+    let setup_w = dot_lanes(map.forward, &q);
+    let (q, q_abs) = match map.origin {
+        Some(o0) => (
+            [
+                q[0] - L::splat(o0.x),
+                q[1] - L::splat(o0.y),
+                q[2] - L::splat(o0.z),
+            ],
+            [
+                abs(q[0]) + L::splat(o0.x.abs()),
+                abs(q[1]) + L::splat(o0.y.abs()),
+                abs(q[2]) + L::splat(o0.z.abs()),
+            ],
+        ),
+        None => (q, [abs(q[0]), abs(q[1]), abs(q[2])]),
+    };
+    let [ra, rb, rc] = map.rows;
+    let (a, b, c) = (dot_lanes(ra, &q), dot_lanes(rb, &q), dot_lanes(rc, &q));
+    let bound = L::splat(16.0 * EPS);
+    let sa = dot_lanes(map.rows_abs[0], &q_abs) * bound;
+    let sb = dot_lanes(map.rows_abs[1], &q_abs) * bound;
+    let sc = dot_lanes(map.rows_abs[2], &q_abs) * bound;
+    let near = L::splat(map.near_bound);
+    let nearer = (c + sc).lt(near) & (setup_w + sc).lt(near);
+    let sure = (c - sc).ge(near) & (c - sc).gt(L::splat(0.0));
+    let (x, y, pad) = match map.origin {
+        Some(_) => (a, b, max_f32(sa, sb)),
+        None => {
+            let (x, y) = (a / c, b / c);
+            let two = L::splat(2.0);
+            let off_x = two * (sa + (abs(x) + sa / c) * sc) / c;
+            let off_y = two * (sb + (abs(y) + sb / c) * sc) / c;
+            (x, y, max_f32(off_x, off_y))
+        }
+    };
+    let pad =
+        pad + L::splat(8.0 * EPS) * max_f32(abs(x), abs(y)) + L::splat(1.0 / (1 << 20) as f32);
+    let projected = sure & finite(x) & finite(y) & finite(pad);
+    let (x, y, pad) = (x.to_array(), y.to_array(), pad.to_array());
+    std::array::from_fn(|l| {
+        if nearer >> l & 1 == 1 {
+            ImagePoint::Nearer
+        } else if projected >> l & 1 == 1 {
+            ImagePoint::Projected {
+                x: x[l],
+                y: y[l],
+                pad: pad[l],
+            }
+        } else {
+            ImagePoint::Unsure
+        }
+    })
+}
+
+/// `f32::max` per lane: the other operand where one is NaN (x86's `maxps`
+/// alone gives the second one).
+#[inline(always)]
+fn max_f32<L: Lanes>(a: L, b: L) -> L {
+    L::select(b.eq(b), a.max(b), a)
+}
 
 simd::dispatch! {
     /// [`ImageBox::of`] and [`ImageBox::pixels`] for eight triangles, one per
@@ -951,6 +1048,79 @@ mod tests {
         );
         // `pixels_eight` takes AVX2 where the CPU has it.
         eight_boxes_are_the_single_ones(pixels_eight);
+    }
+
+    /// `points` (one of the lane forms of [`points_eight`]) gives, lane by
+    /// lane and bit for bit, the point [`ImageMap::point`] gives each vertex:
+    /// perspective and orthographic views near and far from the origin, with
+    /// vertices in view, about the near plane (nearer, unsure), behind the
+    /// eye, at the eye, and so far away or non-finite that the point is not.
+    fn eight_points_are_the_single_ones(points: fn(&ImageMap, [Vec3; 8], Vec3) -> [ImagePoint; 8]) {
+        let bits = |p: ImagePoint| match p {
+            ImagePoint::Projected { x, y, pad } => Some([x, y, pad].map(f32::to_bits)),
+            ImagePoint::Nearer | ImagePoint::Unsure => None,
+        };
+        let mut rng = fastrand::Rng::with_seed(41);
+        let mut kinds = [0; 3];
+        for case in 0..3_000 {
+            let (eye, target, viewport) = random_look(&mut rng, case, 4, &[0.5, 10.0, 60.0, 170.0]);
+            let size = (rng.u32(1..3000), rng.u32(1..3000));
+            let near = [1e-3, 0.1, 1.0][rng.usize(0..3)];
+            let view = view(eye, target, viewport, size, near);
+            let map = ImageMap::new(&view);
+            let p: [Vec3; 8] = std::array::from_fn(|_| {
+                let off = Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5);
+                let depth = match rng.u32(0..8) {
+                    // About the near plane, where the bound decides.
+                    0 => near * (0.99 + rng.f32() * 0.02),
+                    // Within ulps of the bound, where `c` and the setups'
+                    // own depth may round to opposite sides of it.
+                    1 => map.near_bound * (1.0 + (rng.f32() - 0.5) * 1e-5),
+                    2 => -rng.f32() * 5.0,
+                    3 => 0.0,
+                    4 => [1e20, 1e38, f32::INFINITY, f32::NAN][rng.usize(0..4)],
+                    _ => rng.f32() * 100.0,
+                };
+                eye + (target - eye) * depth + off * depth.abs().min(1e3)
+            });
+            let lanes = points(&map, p, view.eye);
+            for (l, lane) in lanes.into_iter().enumerate() {
+                let single = map.point(p[l] - view.eye);
+                let at = format!("case {case} lane {l}: {:?} on {view:?}", p[l]);
+                assert_eq!(
+                    std::mem::discriminant(&lane),
+                    std::mem::discriminant(&single),
+                    "{at}"
+                );
+                assert_eq!(bits(lane), bits(single), "{at}");
+                kinds[match single {
+                    ImagePoint::Projected { .. } => 0,
+                    ImagePoint::Nearer => 1,
+                    ImagePoint::Unsure => 2,
+                }] += 1;
+            }
+        }
+        assert_eq!(kinds.iter().sum::<usize>(), 24_000);
+        assert!(
+            kinds.iter().all(|&k| k > 1_000),
+            "projected, nearer, unsure: {kinds:?}"
+        );
+    }
+
+    #[test]
+    fn portable_eight_points_are_the_single_ones() {
+        eight_points_are_the_single_ones(points_eight_on::<simd::Portable>);
+    }
+
+    #[test]
+    fn avx2_eight_points_are_the_single_ones() {
+        #[cfg(target_arch = "x86_64")]
+        assert!(
+            simd::cpu_has_avx2(),
+            "this test checks the AVX2 kernel, and this CPU has no AVX2"
+        );
+        // `points_eight` takes AVX2 where the CPU has it.
+        eight_points_are_the_single_ones(points_eight);
     }
 
     /// [`ScreenBoxes::node_rects`] is [`ScreenBoxes::node_rect`] per box, on

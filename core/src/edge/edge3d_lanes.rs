@@ -74,6 +74,11 @@ fn setup_eight_with(
     view: &View,
     kernel: fn(&Corners, &View) -> LaneSetups,
 ) -> [Option<Triangle3D>; 8] {
+    // Off-screen triangles come in runs (the mesh's order is spatial):
+    // eight at once with no box skip the kernel.
+    if present == 0 {
+        return [None; 8];
+    }
     if view.is_orthographic() {
         return std::array::from_fn(|l| {
             (present >> l & 1 == 1)
