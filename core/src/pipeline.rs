@@ -326,6 +326,21 @@ fn rays_with(oracles: &Oracles) -> Result<Pipeline, String> {
     }
 }
 
+impl AlgorithmId {
+    /// A setting of the oracles this algorithm takes, for forms and help
+    /// texts to show (each is accepted: a test renders every one); `None`
+    /// when it takes none (`2dr-scanline`, the GPU).
+    pub fn oracles_example(self) -> Option<&'static str> {
+        match self.pipeline() {
+            Pipeline::AllTriangles { samples, .. } if samples.spans => None,
+            Pipeline::AllTriangles { .. } => Some("binning=off,early_z=on"),
+            Pipeline::Frusta(_) => Some("split=16,occluded=off"),
+            Pipeline::Rays { .. } => Some("packet=4"),
+            Pipeline::Gpu | Pipeline::Compute(_) => None,
+        }
+    }
+}
+
 impl Pipeline {
     /// This pipeline with `oracles` set on top of its own. The traversal
     /// keys need a BVH algorithm, `packet` the ray caster, which takes no

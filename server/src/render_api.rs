@@ -370,7 +370,8 @@ pub async fn algorithms() -> Result<Json<Value>, ApiError> {
                     .filter(|v| serves("viewport", &|r| r.camera.viewport = **v))
                     .map(Viewport::kind)
                     .collect::<Vec<_>>(),
-                "takes_oracles": serves("oracles", &|r| r.oracles.early_z = Some(false)),
+                "takes_oracles": a.oracles_example().is_some(),
+                "oracles_example": a.oracles_example(),
                 "aa": AaMode::all()
                     .iter()
                     .filter(|m| serves("aa", &|r| r.aa = **m))

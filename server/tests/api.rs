@@ -737,6 +737,39 @@ fn algorithms_say_whether_this_server_runs_them() {
     }
 }
 
+/// `/api/algorithms` gives each algorithm that takes oracles an example
+/// setting, which renders; the others (`2dr-scanline`, the GPU) are listed
+/// as taking none, and a render of theirs with oracles is a 400 naming
+/// `oracles`.
+#[test]
+fn every_oracles_example_renders() {
+    let s = state(Limits::default());
+    let (_, body) = get(&s, "/api/algorithms");
+    let doc: serde_json::Value = serde_json::from_slice(&body).expect("json");
+    let list = doc["algorithms"].as_array().expect("list");
+    let (mut rendered, mut refused) = (0, 0);
+    for a in list {
+        let id = a["id"].as_str().expect("id");
+        let takes = a["takes_oracles"].as_bool().expect("takes_oracles");
+        assert_eq!(takes, a["oracles_example"].is_string(), "{a}");
+        let oracles = a["oracles_example"].as_str().unwrap_or("early_z=on");
+        let body = format!(
+            r#"{{ "scene": "box", "algorithm": "{id}", "size": "16x16", "oracles": "{oracles}" }}"#
+        );
+        let (status, answer) = post(&s, "/api/render", &body);
+        if takes {
+            assert_eq!(status, StatusCode::OK, "{id} with {oracles}: {answer}");
+            rendered += 1;
+        } else {
+            assert_eq!(status, StatusCode::BAD_REQUEST, "{id}: {answer}");
+            assert_eq!(answer["field"], "oracles", "{id}: {answer}");
+            refused += 1;
+        }
+    }
+    // Every CPU algorithm but `2dr-scanline` takes oracles.
+    assert_eq!((rendered, refused), (9, list.len() - 9));
+}
+
 /// Overlays over HTTP: as a list or as words, drawn over every image asked
 /// for (the images change, the render's hashes do not), and listed with
 /// their legend by `/api/algorithms`.

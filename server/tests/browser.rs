@@ -129,7 +129,25 @@ fn the_page_renders_switches_maps_and_compares() {
         assert_ne!(heat, src, "the image switched to the heat map");
         std::fs::write(shots.join("browser-heat-map.png"), client.screenshot().await.expect("screenshot")).expect("save");
 
-        // 3. Effects: a texture filter on the checkerboard, then the glass panes;
+        // 3. The oracles field follows the algorithm: its example as the
+        // placeholder, off for an algorithm that takes none.
+        let oracles_a = || async { client.find(Locator::Id("oracles-a")).await.expect("oracles-a") };
+        for (algorithm, placeholder, enabled) in [
+            ("raycast", "e.g. packet=4", true),
+            ("3dr-full", "e.g. split=16,occluded=off", true),
+            ("2dr-scanline", "this algorithm takes none", false),
+        ] {
+            client.find(Locator::Id("algorithm-a")).await.expect("algorithm-a")
+                .select_by_value(algorithm).await.expect("select the algorithm");
+            let field = oracles_a().await;
+            let shown = field.attr("placeholder").await.expect("placeholder");
+            assert_eq!(shown.as_deref(), Some(placeholder), "{algorithm}");
+            assert_eq!(field.is_enabled().await.expect("enabled"), enabled, "{algorithm}");
+        }
+        client.find(Locator::Id("algorithm-a")).await.expect("algorithm-a")
+            .select_by_value("3dr-full").await.expect("select 3dr-full");
+
+        // 4. Effects: a texture filter on the checkerboard, then the glass panes;
         // the stats table lists what each effect cost.
         client.find(Locator::Css("button[data-view=color]")).await.expect("button").click().await.expect("click");
         client.find(Locator::Id("texture-filter")).await.expect("filter").send_keys("anisotropic:8\n").await.expect("type");
@@ -141,14 +159,14 @@ fn the_page_renders_switches_maps_and_compares() {
         assert!(stats.contains("transparency") && stats.contains("shadows"), "{stats}");
         std::fs::write(shots.join("browser-pane.png"), client.screenshot().await.expect("screenshot")).expect("save");
 
-        // 4. Downloads and "copy as curl" for the last render.
+        // 5. Downloads and "copy as curl" for the last render.
         let downloads = text_of("downloads").await;
         assert!(downloads.contains("color.png") && downloads.contains("statistics.json"), "{downloads}");
         client.find(Locator::Id("copy-curl")).await.expect("copy as curl").click().await.expect("click");
         let curl = wait_until("copy as curl", "curl", "curl -X POST").await;
         assert!(curl.contains("/api/render") && curl.contains("\"scene\":\"pane\""), "{curl}");
 
-        // 5. Upload a .glb through the page and render it.
+        // 6. Upload a .glb through the page and render it.
         let glb = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes/assets/Box.glb");
         let glb = glb.canonicalize().expect("Box.glb");
         client.find(Locator::Id("upload-name")).await.expect("name").send_keys("my-box").await.expect("type");
@@ -161,7 +179,7 @@ fn the_page_renders_switches_maps_and_compares() {
         wait_until("the uploaded scene's render", "stats", "total ms").await;
         wait_until("the uploaded scene's downloads", "downloads", "my-box-").await;
 
-        // 6. The compare view: two images, their difference, the timing bars.
+        // 7. The compare view: two images, their difference, the timing bars.
         client.find(Locator::Id("show-compare")).await.expect("compare").click().await.expect("click");
         let caption = wait_until("compare", "cap-diff", " differ").await;
         assert!(caption.contains("difference"), "{caption}");
