@@ -717,7 +717,9 @@ fn method_controls(ui: &mut egui::Ui, id: &str, method: &mut Method) {
             let label = ui.label("oracles");
             ui.add(
                 egui::TextEdit::singleline(&mut method.oracles)
-                    .hint_text("outside=on,split=8,…")
+                    .hint_text(
+                        (method.algorithm.oracles_example()).unwrap_or("none for this algorithm"),
+                    )
                     .desired_width(140.0),
             )
             .labelled_by(label.id)
