@@ -370,7 +370,11 @@ pub async fn algorithms() -> Result<Json<Value>, ApiError> {
                     .filter(|v| serves("viewport", &|r| r.camera.viewport = **v))
                     .map(Viewport::kind)
                     .collect::<Vec<_>>(),
-                "takes_oracles": a.oracles_example().is_some(),
+                // Asked of the check, as the other fields are: does it
+                // take the algorithm's own example?
+                "takes_oracles": (a.oracles_example())
+                    .and_then(|example| continuum::Oracles::parse(example).ok())
+                    .is_some_and(|o| serves("oracles", &|r| r.oracles = o)),
                 "oracles_example": a.oracles_example(),
                 "aa": AaMode::all()
                     .iter()
