@@ -22,10 +22,12 @@
 //! fails on a back edge or a cycle). ARCHITECTURE.md draws the floors.
 
 // floors: lowest first; a module imports only modules declared above it.
-// Floor 0 — vocabulary: the one error type, rectangles, ids, boxes; lanes.
+// Floor 0 — vocabulary: the one error type, rectangles, ids, boxes; lanes;
+// copies past the cache.
 mod ground;
 pub mod mesa;
 mod simd;
+mod stream;
 // Floor 1 — settings a request names.
 mod aa;
 mod color;

@@ -39,6 +39,7 @@ use crate::shade::Shader;
 use crate::shade::eight::EightSamples;
 use crate::simd::{self, Lanes};
 use crate::stats::CoverageHistogram;
+use crate::stream;
 
 /// Most stored samples a pattern has (`ssaa:256`).
 const MAX_STORED: usize = 256;
@@ -121,26 +122,33 @@ fn resolve_tile(tile: &TileBuffer, out: &mut TilePlanes) -> TileTotals {
     let (stored, pixels) = (pattern.stored, tile.pixels);
     let width = (tile.x1 - tile.x0) as usize;
     let masks = pattern.has_coverage_only();
-    // The counters are taken row by row, while the row is in cache.
+    // The first sample's planes, copied past the cache (`stream`); with one
+    // sample a pixel, the coverage writes too (more are summed below).
+    stream::copy_rows(&mut out.depth, &tile.depth[..pixels]);
+    stream::copy_rows(&mut out.triangle_id, &tile.triangle_id[..pixels]);
+    stream::copy_rows(&mut out.edge_evals, &tile.edge_evals[..pixels]);
+    if stored == 1 {
+        stream::copy_rows(&mut out.coverage_writes, &tile.coverage_writes[..pixels]);
+    }
+    // The counters are taken row by row from the tile (in L1).
     let (mut histogram, mut edge_evaluations, mut max_edge_evals) =
         (CoverageHistogram::default(), 0u64, 0u32);
     for (r, start) in (0..pixels).step_by(width).enumerate() {
         let row = start..start + width;
-        out.depth[r].copy_from_slice(&tile.depth[row.clone()]);
-        out.triangle_id[r].copy_from_slice(&tile.triangle_id[row.clone()]);
         let evals = &tile.edge_evals[row.clone()];
-        out.edge_evals[r].copy_from_slice(evals);
-        // Two plain reductions over the row (in L1): each vectorizes.
+        // Two plain reductions over the row: each vectorizes.
         edge_evaluations += evals.iter().map(|&e| u64::from(e)).sum::<u64>();
         max_edge_evals = max_edge_evals.max(evals.iter().copied().max().unwrap_or(0));
-        let writes = &mut *out.coverage_writes[r];
-        writes.copy_from_slice(&tile.coverage_writes[row.clone()]);
-        histogram += CoverageHistogram::of(writes);
-        for s in 1..stored {
-            let layer = &tile.coverage_writes[s * pixels + start..][..width];
-            histogram += CoverageHistogram::of(layer);
-            for (sum, &w) in writes.iter_mut().zip(layer) {
-                *sum += w;
+        histogram += CoverageHistogram::of(&tile.coverage_writes[row.clone()]);
+        if stored > 1 {
+            let writes = &mut *out.coverage_writes[r];
+            writes.copy_from_slice(&tile.coverage_writes[row.clone()]);
+            for s in 1..stored {
+                let layer = &tile.coverage_writes[s * pixels + start..][..width];
+                histogram += CoverageHistogram::of(layer);
+                for (sum, &w) in writes.iter_mut().zip(layer) {
+                    *sum += w;
+                }
             }
         }
         // The digest of every sample's id (and mask), sample by sample.
