@@ -176,26 +176,15 @@ impl PreparedScene {
         self.scene.mesh.triangle_count()
     }
 
-    /// The vertex positions of triangle `id` (any id, degenerate ones too).
+    /// The vertex positions of triangle `id` (any id, degenerate ones too),
+    /// read from the slot-ordered copies where the BVH holds it: triangles
+    /// side by side on screen are side by side there, whatever the mesh's
+    /// own order.
     #[inline(always)]
     pub fn triangle(&self, id: u32) -> [Vec3; 3] {
-        self.corners_and_vertices(id).0
-    }
-
-    /// Triangle `id`'s vertex positions and vertex indices, read from the
-    /// slot-ordered copies where the BVH holds it: triangles side by side on
-    /// screen are side by side there, whatever the mesh's own order.
-    #[inline(always)]
-    pub(crate) fn corners_and_vertices(&self, id: u32) -> ([Vec3; 3], [u32; 3]) {
         match self.slot_of[id as usize] {
-            NO_SLOT => (
-                self.scene.mesh.triangle_positions(id as usize),
-                self.scene.mesh.triangles[id as usize],
-            ),
-            slot => (
-                self.slot_corners[slot as usize],
-                self.slot_vertices[slot as usize],
-            ),
+            NO_SLOT => self.scene.mesh.triangle_positions(id as usize),
+            slot => self.slot_corners[slot as usize],
         }
     }
 }

@@ -84,7 +84,9 @@ mod tests {
         for offset in 0..4 {
             for len in [0, 1, 3, 4, 5, 7, 8, 15, 16, 17, 64, 257] {
                 let rows = 3;
-                let src: Vec<u32> = (0..(rows * len) as u32).map(|v| v.wrapping_mul(2654435761)).collect();
+                let src: Vec<u32> = (0..(rows * len) as u32)
+                    .map(|v| v.wrapping_mul(2654435761))
+                    .collect();
                 let mut plane = vec![u32::MAX; offset + rows * (len + 2)];
                 let mut dst: Vec<&mut [u32]> = plane[offset..]
                     .chunks_mut(len + 2)
