@@ -32,14 +32,14 @@ pub(crate) fn copy_rows<T: Word>(dst: &mut [&mut [T]], src: &[T]) {
         start += row.len();
         copy_row(row, from);
     }
-    #[cfg(target_arch = "x86_64")]
     // SAFETY: `_mm_sfence` needs SSE, which every x86-64 CPU has. It orders
     // the non-temporal stores above before every later store of this thread
     // (and so before whatever publishes the rows to another thread): the
     // fence their intrinsic asks for before the memory is accessed again.
+    #[cfg(target_arch = "x86_64")]
     unsafe {
-        std::arch::x86_64::_mm_sfence()
-    };
+        std::arch::x86_64::_mm_sfence();
+    }
 }
 
 /// One row of [`copy_rows`], unfenced.
