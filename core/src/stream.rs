@@ -2,9 +2,9 @@
 //! (a 1080p frame: five of 8 MB) are written once per render, tile by tile,
 //! and not read again while the lines would still be cached; a cached store
 //! first reads each line it writes from memory. Non-temporal stores write
-//! whole lines without that read: the resolve of a 1080p frame costs 1–1.5 ms
-//! less on two threads (`continuum compare`, 3dr-brute and 3dr-full on the
-//! five benchmark scenes).
+//! whole lines without that read: a 1080p frame's resolve, shading and store
+//! took 0.6–1.7 ms less on two threads (`continuum compare`, 3dr-brute,
+//! 3dr-full and raycast on the five benchmark scenes, alternated runs).
 
 /// Four-byte plain values: any bits copied from one are one.
 pub(crate) trait Word: Copy + sealed::Sealed {}
