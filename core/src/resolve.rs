@@ -130,22 +130,20 @@ fn resolve_tile(tile: &TileBuffer, out: &mut TilePlanes) -> TileTotals {
     if stored == 1 {
         stream::copy_rows(&mut out.coverage_writes, &tile.coverage_writes[..pixels]);
     }
-    // The counters are taken row by row from the tile (in L1).
-    let (mut histogram, mut edge_evaluations, mut max_edge_evals) =
-        (CoverageHistogram::default(), 0u64, 0u32);
+    // The counters, from the tile (in cache): plain reductions, which vectorize.
+    let evals = &tile.edge_evals[..pixels];
+    let edge_evaluations = evals.iter().map(|&e| u64::from(e)).sum::<u64>();
+    let max_edge_evals = evals.iter().copied().max().unwrap_or(0);
+    let mut histogram = CoverageHistogram::default();
+    for layer in tile.coverage_writes.chunks_exact(pixels).take(stored) {
+        histogram += CoverageHistogram::of(layer);
+    }
     for (r, start) in (0..pixels).step_by(width).enumerate() {
-        let row = start..start + width;
-        let evals = &tile.edge_evals[row.clone()];
-        // Two plain reductions over the row: each vectorizes.
-        edge_evaluations += evals.iter().map(|&e| u64::from(e)).sum::<u64>();
-        max_edge_evals = max_edge_evals.max(evals.iter().copied().max().unwrap_or(0));
-        histogram += CoverageHistogram::of(&tile.coverage_writes[row.clone()]);
         if stored > 1 {
             let writes = &mut *out.coverage_writes[r];
-            writes.copy_from_slice(&tile.coverage_writes[row.clone()]);
+            writes.copy_from_slice(&tile.coverage_writes[start..start + width]);
             for s in 1..stored {
                 let layer = &tile.coverage_writes[s * pixels + start..][..width];
-                histogram += CoverageHistogram::of(layer);
                 for (sum, &w) in writes.iter_mut().zip(layer) {
                     *sum += w;
                 }
