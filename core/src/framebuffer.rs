@@ -35,13 +35,15 @@ pub struct Framebuffer {
     pub depth: Vec<f32>,
     /// Id of the visible triangle; [`BACKGROUND`] where none.
     pub triangle_id: Vec<u32>,
-    /// Samples-against-triangle tests made at each pixel (each evaluates three edges).
+    /// Samples-against-triangle tests made at each pixel (each evaluates three
+    /// edges); empty when the request asked for no counter planes
+    /// (`RenderRequest::counter_planes`).
     pub edge_evals: Vec<u32>,
     /// Samples that passed a coverage test at each pixel, before the depth test,
     /// summed over the pixel's stored samples. Algorithms with early-z or
     /// occlusion culling skip hidden blocks before testing them, so they count
     /// fewer here (never on a closed mesh seen from inside, where every sample has
-    /// exactly one triangle).
+    /// exactly one triangle). Empty when the request asked for no counter planes.
     pub coverage_writes: Vec<u32>,
     /// With anti-aliasing: per pixel, a 64-bit hash of its samples' triangle ids
     /// (and CSAA coverage masks), so renders can be compared sample by sample;
@@ -90,16 +92,18 @@ impl Framebuffer {
     /// ([`Framebuffer::tile_planes`]): those of an earlier render of the same
     /// size when one was [recycled](Framebuffer::recycle), as they are (every
     /// pixel is written, so nothing is cleared), else zeroed memory straight
-    /// from the allocator. `sample_digest` and `blended` are there when asked for.
-    pub(crate) fn for_tiles(width: u32, height: u32, digest: bool, blended: bool) -> Framebuffer {
+    /// from the allocator. The counter planes (`edge_evals`,
+    /// `coverage_writes`), `sample_digest` and `blended` are there when
+    /// asked for, empty otherwise (keeping their memory for the next render
+    /// that asks).
+    pub(crate) fn for_tiles(width: u32, height: u32, optional: Optional) -> Framebuffer {
         let n = width as usize * height as usize;
         let spare = {
             let mut pool = FRAME_POOL.lock().unwrap_or_else(|e| e.into_inner());
             let fits = |f: &Framebuffer| {
                 (f.width, f.height) == (width, height)
-                    && [f.depth.len(), f.triangle_id.len(), f.edge_evals.len()]
+                    && [f.depth.len(), f.triangle_id.len(), f.color.len()]
                         .iter()
-                        .chain(&[f.coverage_writes.len(), f.color.len()])
                         .all(|&len| len == n)
             };
             let at = pool.iter().position(fits);
@@ -111,20 +115,25 @@ impl Framebuffer {
             color: vec![[0; 4]; n],
             depth: vec![0.0; n],
             triangle_id: vec![0; n],
-            edge_evals: vec![0; n],
-            coverage_writes: vec![0; n],
+            edge_evals: Vec::new(),
+            coverage_writes: Vec::new(),
             sample_digest: Vec::new(),
             blended: Vec::new(),
         });
-        fn optional<T: Copy + Default>(plane: &mut Vec<T>, wanted: bool, n: usize) {
+        fn plane<T: Copy + Default>(plane: &mut Vec<T>, wanted: bool, n: usize) {
             if !wanted {
                 plane.clear();
-            } else if plane.len() != n {
+            } else if plane.capacity() < n {
                 *plane = vec![T::default(); n];
+            } else if plane.len() != n {
+                plane.clear();
+                plane.resize(n, T::default());
             }
         }
-        optional(&mut fb.sample_digest, digest, n);
-        optional(&mut fb.blended, blended, n);
+        plane(&mut fb.edge_evals, optional.counters, n);
+        plane(&mut fb.coverage_writes, optional.counters, n);
+        plane(&mut fb.sample_digest, optional.digest, n);
+        plane(&mut fb.blended, optional.blended, n);
         fb
     }
 
@@ -163,6 +172,7 @@ impl Framebuffer {
         }
         // Each tile's rows, allocated once (an optional plane the render
         // has not gets none).
+        let counters = !self.edge_evals.is_empty();
         let (digest, blended) = (!self.sample_digest.is_empty(), !self.blended.is_empty());
         let mut planes: Vec<TilePlanes> = rects
             .iter()
@@ -174,8 +184,8 @@ impl Framebuffer {
                     color: Vec::with_capacity(h),
                     depth: Vec::with_capacity(h),
                     triangle_id: Vec::with_capacity(h),
-                    edge_evals: Vec::with_capacity(h),
-                    coverage_writes: Vec::with_capacity(h),
+                    edge_evals: Vec::with_capacity(optional(counters)),
+                    coverage_writes: Vec::with_capacity(optional(counters)),
                     sample_digest: Vec::with_capacity(optional(digest)),
                     blended: Vec::with_capacity(optional(blended)),
                 }
@@ -224,6 +234,18 @@ impl Framebuffer {
         });
         planes
     }
+}
+
+/// The planes of a frame that a render may go without
+/// ([`Framebuffer::for_tiles`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Optional {
+    /// `edge_evals` and `coverage_writes` ([`crate::RenderRequest::counter_planes`]).
+    pub counters: bool,
+    /// `sample_digest`: with anti-aliasing.
+    pub digest: bool,
+    /// `blended`: with transparency in the scene.
+    pub blended: bool,
 }
 
 /// Frames kept by [`Framebuffer::recycle`]: two (the viewer shows two at once; the

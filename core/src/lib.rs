@@ -13,7 +13,7 @@
 //! let camera = prepared.scene.first_camera();
 //! let request = RenderRequest::new(AlgorithmId::ThreeDBrute, camera, 640, 480);
 //! let out = render(&prepared, &request).unwrap();
-//! println!("{}", out.hashes.triangle_id);
+//! println!("{}", out.hashes().triangle_id);
 //! ```
 //!
 //! # Floors

@@ -27,7 +27,12 @@ pub fn color_image(fb: &Framebuffer) -> RgbaImage {
     from_pixels(fb, fb.color.iter().copied())
 }
 
+/// The heat map of `fb.edge_evals`; black where a frame rendered without
+/// counter planes (`RenderRequest::counter_planes` off) has none.
 pub fn edge_eval_image(fb: &Framebuffer) -> RgbaImage {
+    if fb.edge_evals.is_empty() {
+        return from_pixels(fb, std::iter::repeat_n([0, 0, 0, 255], fb.color.len()));
+    }
     let max = fb.edge_evals.iter().copied().max().unwrap_or(0);
     from_pixels(
         fb,

@@ -33,6 +33,13 @@ pub struct RenderRequest {
     /// colour-coded" — each sample keeps the smallest id covering it, with
     /// that triangle's depth; only the GPU compute algorithms render so.
     pub depth_test: bool,
+    /// Write the per-pixel counters (`Framebuffer::edge_evals` and
+    /// `coverage_writes`, what heat maps and the watertightness checks read)
+    /// into the frame: on, the default. Off, the frame holds colours, depths
+    /// and ids alone (the counters' planes are empty) and the counters reach
+    /// only their totals in `Stats`, which are the same either way: what
+    /// `compare` times, as a renderer writes no diagnostic planes unasked.
+    pub counter_planes: bool,
 }
 
 impl RenderRequest {
@@ -50,6 +57,7 @@ impl RenderRequest {
             texture_filter: TextureFilter::default(),
             trace: false,
             depth_test: true,
+            counter_planes: true,
         }
     }
 }

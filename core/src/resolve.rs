@@ -123,7 +123,8 @@ fn resolve_tile(tile: &TileBuffer, out: &mut TilePlanes) -> TileTotals {
     let width = (tile.x1 - tile.x0) as usize;
     let masks = pattern.has_coverage_only();
     // The first sample's planes, copied past the cache (`stream`); with one
-    // sample a pixel, the coverage writes too (more are summed below).
+    // sample a pixel, the coverage writes too (more are summed below). A
+    // frame without counter planes has no rows of them to copy into.
     stream::copy_rows(&mut out.depth, &tile.depth[..pixels]);
     stream::copy_rows(&mut out.triangle_id, &tile.triangle_id[..pixels]);
     stream::copy_rows(&mut out.edge_evals, &tile.edge_evals[..pixels]);
@@ -138,8 +139,9 @@ fn resolve_tile(tile: &TileBuffer, out: &mut TilePlanes) -> TileTotals {
     for layer in tile.coverage_writes.chunks_exact(pixels).take(stored) {
         histogram += CoverageHistogram::of(layer);
     }
+    let summed_writes = stored > 1 && !out.coverage_writes.is_empty();
     for (r, start) in (0..pixels).step_by(width).enumerate() {
-        if stored > 1 {
+        if summed_writes {
             let writes = &mut *out.coverage_writes[r];
             writes.copy_from_slice(&tile.coverage_writes[start..start + width]);
             for s in 1..stored {

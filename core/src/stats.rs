@@ -18,7 +18,8 @@ pub struct StageTimes {
     /// Shading of visible samples, the box filter and the sRGB encode.
     pub shading: f64,
     /// The frame around the algorithm: its planes taken and cut into tiles,
-    /// and the finished frame's totals and hashes.
+    /// and the finished frame's totals. (Not its hashes:
+    /// `RenderOutput::hashes` takes them when asked, off the clock.)
     pub store: f64,
     /// The whole render; the stages above add up to it, less the few
     /// microseconds that set up the view and the shader.

@@ -162,6 +162,7 @@ impl Settings {
             texture_filter: self.texture_filter,
             trace: self.overlays.need_trace(),
             depth_test: true,
+            counter_planes: true,
         })
     }
 

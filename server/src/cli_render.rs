@@ -155,7 +155,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
             s.coverage_histogram.zero,
             s.coverage_histogram.one,
             s.coverage_histogram.many,
-            out.hashes.triangle_id
+            summary.hashes.triangle_id
         ))?;
     }
     Ok(())

@@ -241,7 +241,8 @@ impl Matrix {
             if let Some(first) = first {
                 let label = cell.label();
                 assert_eq!(
-                    cell.output.hashes, first.hashes,
+                    cell.output.hashes(),
+                    first.hashes(),
                     "{label} differs from {}",
                     first.algorithm
                 );

@@ -48,7 +48,7 @@ fn two_pass_visibility_equals_the_64_bit_atomic() {
                     one.framebuffer.coverage_writes, two.framebuffer.coverage_writes,
                     "{label}"
                 );
-                assert_eq!(one.hashes, two.hashes, "{label}");
+                assert_eq!(one.hashes(), two.hashes(), "{label}");
                 compared += 1;
             }
         }

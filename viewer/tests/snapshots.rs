@@ -175,7 +175,7 @@ fn dragging_the_image_orbits_and_double_click_resets() {
         .state()
         .shown_output()
         .expect("a frame")
-        .hashes
+        .hashes()
         .triangle_id
         .clone();
 
@@ -202,7 +202,11 @@ fn dragging_the_image_orbits_and_double_click_resets() {
         out.view.eye, camera.eye,
         "the shown frame uses the moved camera"
     );
-    assert_ne!(out.hashes.triangle_id, before, "orbiting changes the image");
+    assert_ne!(
+        out.hashes().triangle_id,
+        before,
+        "orbiting changes the image"
+    );
 
     // A double click is the Reset button: the scene's camera again.
     let pos = image_centre();
@@ -223,7 +227,7 @@ fn dragging_the_image_orbits_and_double_click_resets() {
         h.state()
             .shown_output()
             .expect("a frame")
-            .hashes
+            .hashes()
             .triangle_id,
         before
     );

@@ -220,7 +220,11 @@ fn algorithm_request(
 
 /// Times `requests` interleaved: one warm-up render each (the GPU uploads
 /// the scene then), then `repeat` rounds of one render per request. Returns
-/// each request's last output and its round times.
+/// each request's warm-up output, carrying the stats of its last round, and
+/// its round times. The timed rounds write no counter planes
+/// ([`RenderRequest::counter_planes`]: a renderer writes no diagnostic planes
+/// unasked; their totals in the stats are the same): the warm-up's frame,
+/// with them, is the one the row's maps and hashes are made from.
 fn time_interleaved(
     pool: &rayon::ThreadPool,
     scene: &LoadedScene,
@@ -235,16 +239,23 @@ fn time_interleaved(
         .iter()
         .map(|r| Ok((render_one(r)?, Times::default())))
         .collect::<Result<Vec<_>, CliError>>()?;
+    let rounds: Vec<RenderRequest> = (requests.iter())
+        .map(|r| RenderRequest {
+            counter_planes: false,
+            ..r.clone()
+        })
+        .collect();
     for _ in 0..repeat {
-        for (request, (out, times)) in requests.iter().zip(&mut timed) {
-            // The previous frame's memory serves the next render, as in the
-            // service and the viewer.
-            std::mem::replace(&mut out.framebuffer, Framebuffer::new(0, 0)).recycle();
-            *out = render_one(request)?;
-            let t = out.stats.time_ms;
+        for (request, (out, times)) in rounds.iter().zip(&mut timed) {
+            let round = render_one(request)?;
+            let t = round.stats.time_ms;
             times.total.push(t.total);
             times.visibility.push(t.total - t.resolve - t.shading);
             times.stages.push(t);
+            out.stats = round.stats;
+            // This frame's memory serves the next render, as in the service
+            // and the viewer.
+            round.framebuffer.recycle();
         }
     }
     Ok(timed)
@@ -294,7 +305,7 @@ fn algorithm_row(
         &out.aa,
         serde_json::to_value(&out.stats).unwrap_or(Value::Null),
     );
-    row.hashes = serde_json::to_value(&out.hashes).unwrap_or(Value::Null);
+    row.hashes = serde_json::to_value(out.hashes()).unwrap_or(Value::Null);
     row.visibility_ms = Some(super::median(times.visibility).0);
     row.stage_ms = Some(median_stages(&times.stages));
     row.precision = cell.precision;

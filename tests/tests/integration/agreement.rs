@@ -26,9 +26,11 @@ fn assert_same_buffers(name: &str, camera: &str, a: &RenderOutput, b: &RenderOut
         a.algorithm, b.algorithm
     );
     assert_eq!(
-        a.hashes, b.hashes,
+        a.hashes(),
+        b.hashes(),
         "{name}/{camera}: {} vs {}",
-        a.algorithm, b.algorithm
+        a.algorithm,
+        b.algorithm
     );
 }
 

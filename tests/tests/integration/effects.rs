@@ -123,12 +123,17 @@ fn every_algorithm_shades_the_same_image_with_effects() {
         }
         let reference = reference.as_ref().expect("3dr-brute renders first");
         assert_eq!(
-            out.hashes.triangle_id,
-            reference.hashes.triangle_id,
+            out.hashes().triangle_id,
+            reference.hashes().triangle_id,
             "{}",
             cell.label()
         );
-        assert_eq!(out.hashes.color, reference.hashes.color, "{}", cell.label());
+        assert_eq!(
+            out.hashes().color,
+            reference.hashes().color,
+            "{}",
+            cell.label()
+        );
         assert_eq!(counts(out), counts(reference), "{}", cell.label());
     });
     // Five scenes, three cameras or more each (theirs and the default), six 3D algorithms.
@@ -217,9 +222,9 @@ fn trilinear_and_anisotropic_filtering_alias_less_than_nearest() {
     let error = |filter| {
         let out = render_filtered(&scene, "grazing", AaMode::None, filter);
         assert_eq!(
-            out.hashes.triangle_id,
+            out.hashes().triangle_id,
             render_filtered(&scene, "grazing", AaMode::None, TextureFilter::Nearest)
-                .hashes
+                .hashes()
                 .triangle_id
         );
         flip_mean(
@@ -510,7 +515,12 @@ fn transparency_agrees_across_the_3d_family_with_anti_aliasing() {
             return;
         }
         let reference = reference.as_ref().expect("3dr-brute renders first");
-        assert_eq!(out.hashes.color, reference.hashes.color, "{}", cell.label());
+        assert_eq!(
+            out.hashes().color,
+            reference.hashes().color,
+            "{}",
+            cell.label()
+        );
         let blended = &out.framebuffer.blended;
         assert_eq!(blended, &reference.framebuffer.blended, "{}", cell.label());
     });

@@ -27,7 +27,7 @@ fn the_trace_records_what_the_counters_count_and_changes_nothing() {
             let traced = render(&scene, &request(&scene, algorithm, true)).unwrap();
             let label = format!("{name} {algorithm}");
             assert!(plain.trace.is_none(), "{label}: a trace nobody asked for");
-            assert_eq!(plain.hashes, traced.hashes, "{label}");
+            assert_eq!(plain.hashes(), traced.hashes(), "{label}");
             assert_eq!(plain.stats.counters, traced.stats.counters, "{label}");
             let trace = traced.trace.as_ref().expect("a trace");
             let c = &traced.stats.counters;
