@@ -12,7 +12,7 @@ use crate::camera::View;
 use crate::clip::{
     ClipPlane, GUARD_BAND, MAX_CLIPPED, clip_triangle, fixed_guard_band, pipeline_planes,
 };
-use crate::edge::{ScreenVertex, Stored, Triangle2D, Triangle2DFixed};
+use crate::edge::{EightVertices, ScreenVertex, Stored, Triangle2D, Triangle2DFixed};
 use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
@@ -24,7 +24,19 @@ pub(crate) fn setup_2d(
     view: &View,
     span: SampleSpan,
 ) -> Setups<'static, Triangle2D> {
-    setup_pieces(scene, view, span, [GUARD_BAND; 2], make_2d(view))
+    let (affine, size) = (view.is_orthographic(), [view.width, view.height]);
+    let make_eight = move |v: &EightVertices, present: u8| {
+        let made = Triangle2D::setup_eight(v, present, affine, size[0], size[1]);
+        made.map(|t| t.map(|t| (t, t.bounds)))
+    };
+    setup_pieces(
+        scene,
+        view,
+        span,
+        [GUARD_BAND; 2],
+        make_2d(view),
+        make_eight,
+    )
 }
 
 /// The f32 setup of one projected piece, with its vertex bounds.
@@ -45,18 +57,27 @@ pub(crate) fn setup_2d_fixed(
     span: SampleSpan,
 ) -> Setups<'static, Triangle2DFixed> {
     let affine = view.is_orthographic();
-    setup_pieces(scene, view, span, fixed_guard_band(view), |v| {
+    let make = move |v: &[ScreenVertex; 3]| {
         let t = Triangle2DFixed::setup(v, affine)?;
         Some((t, t.bounds))
-    })
+    };
+    let make_eight = move |v: &EightVertices, present: u8| {
+        std::array::from_fn(|l| match present >> l & 1 {
+            1 => make(&[v[0][l], v[1][l], v[2][l]]),
+            _ => None,
+        })
+    };
+    setup_pieces(scene, view, span, fixed_guard_band(view), make, make_eight)
 }
 
 /// Clips (the guard band `guard` in units of the half-extents), projects and
 /// fan-triangulates every drawable triangle; `make` sets up each piece and
-/// gives its pixel bounds `[min_x, min_y, max_x, max_y]`. One item per drawable
-/// triangle holds its first piece (exactly sized, parallel collects written
-/// in place); the further pieces of the few triangles clipping cuts into
-/// several follow, set up again in a second, small pass.
+/// gives its pixel bounds `[min_x, min_y, max_x, max_y]`, and `make_eight`
+/// does what `make` does for the present lanes of eight unclipped triangles
+/// at once. One item per drawable triangle holds its first piece (exactly
+/// sized, parallel collects written in place, eight items at a time); the
+/// further pieces of the few triangles clipping cuts into several follow,
+/// set up again in a second, small pass.
 ///
 /// Vertices are transformed and projected once each, as a vertex shader
 /// would ([`screen_vertices`]): a triangle whose three vertices are inside
@@ -69,6 +90,7 @@ fn setup_pieces<T: Stored<Shared<'static> = ()>>(
     span: SampleSpan,
     guard: [f32; 2],
     make: impl Fn(&[ScreenVertex; 3]) -> Option<(T, [f32; 4])> + Sync,
+    make_eight: impl Fn(&EightVertices, u8) -> [Option<(T, [f32; 4])>; 8] + Sync,
 ) -> Setups<'static, T> {
     let planes = pipeline_planes(view, guard);
     let kept = screen_vertices(scene, view, &planes);
@@ -78,31 +100,62 @@ fn setup_pieces<T: Stored<Shared<'static> = ()>>(
         Some(Piece { tri, rect, id }) => (ItemBox::new(rect, id), Some(tri)),
         None => (ItemBox::NONE, None),
     };
-    let (first, more): (Columns<T>, Vec<bool>) = scene
-        .drawable
-        .par_iter()
-        .map(|&id| {
-            if let [Some(a), Some(b), Some(c)] = corners[id as usize].map(|v| kept[v as usize]) {
-                return (item(piece(view, span, &make, &[a, b, c], id)), false);
+    let origin = ScreenVertex {
+        x: 0.0,
+        y: 0.0,
+        q: 0.0,
+    };
+    let (first, more): (Columns<T>, Vec<u8>) = (scene.drawable.par_chunks(8))
+        .map(|ids| {
+            // The lanes whose three vertices are all kept, set up together.
+            let mut vertices: EightVertices = [[origin; 8]; 3];
+            let mut unclipped = 0u8;
+            for (l, &id) in ids.iter().enumerate() {
+                if let [Some(a), Some(b), Some(c)] = corners[id as usize].map(|v| kept[v as usize])
+                {
+                    [vertices[0][l], vertices[1][l], vertices[2][l]] = [a, b, c];
+                    unclipped |= 1 << l;
+                }
             }
-            let mut pieces = pieces(id).into_iter().flatten();
-            (item(pieces.next()), pieces.next().is_some())
+            let mut made = make_eight(&vertices, unclipped).into_iter();
+            let (mut boxes, mut triangles) = ([ItemBox::NONE; 8], [const { None }; 8]);
+            let mut more = 0u8;
+            for (l, &id) in ids.iter().enumerate() {
+                let made = made.next().flatten();
+                let first = if unclipped >> l & 1 == 1 {
+                    placed(view, span, made, id)
+                } else {
+                    let mut pieces = pieces(id).into_iter().flatten();
+                    let first = pieces.next();
+                    more |= u8::from(pieces.next().is_some()) << l;
+                    first
+                };
+                (boxes[l], triangles[l]) = item(first);
+            }
+            ((boxes, triangles), more)
         })
         .unzip();
-    let rest: Vec<(ItemBox, Option<T>)> = scene
-        .drawable
-        .par_iter()
+    let rest: Vec<(ItemBox, Option<T>)> = (scene.drawable.par_chunks(8))
         .zip(&more)
-        .filter(|&(_, &more)| more)
-        .flat_map_iter(|(&id, _)| {
-            pieces(id)
-                .into_iter()
-                .flatten()
-                .skip(1)
-                .map(|p| item(Some(p)))
+        .filter(|&(_, &more)| more != 0)
+        .flat_map_iter(|(ids, &more)| {
+            let several = ids
+                .iter()
+                .enumerate()
+                .filter(move |&(l, _)| more >> l & 1 == 1);
+            several.flat_map(|(_, &id)| {
+                pieces(id)
+                    .into_iter()
+                    .flatten()
+                    .skip(1)
+                    .map(|p| item(Some(p)))
+            })
         })
         .collect();
-    let (mut boxes, mut triangles) = first;
+    let (boxes, triangles) = first;
+    let (mut boxes, mut triangles) = (boxes.into_flattened(), triangles.into_flattened());
+    boxes.truncate(scene.drawable.len());
+    triangles.truncate(scene.drawable.len());
     for (b, t) in rest {
         boxes.push(b);
         triangles.push(t);
@@ -136,8 +189,8 @@ pub(crate) fn clipped_pieces(
         .collect()
 }
 
-/// Items' boxes and triangles, before they are [`Setups`].
-type Columns<T> = (Vec<ItemBox>, Vec<Option<T>>);
+/// Items' boxes and triangles, eight at a time, before they are [`Setups`].
+type Columns<T> = (Vec<[ItemBox; 8]>, Vec<[Option<T>; 8]>);
 
 /// One set-up piece of a triangle with its pixels and the triangle's id.
 struct Piece<T> {
@@ -182,17 +235,16 @@ fn screen_vertex(view: &View, c: DVec3) -> ScreenVertex {
     }
 }
 
-/// One projected piece of triangle `id` set up by `make`, with its pixels;
+/// A piece of triangle `id` set up (with its bounds) with its pixels;
 /// `None` when it has no samples on screen.
 #[inline]
-fn piece<T>(
+fn placed<T>(
     view: &View,
     span: SampleSpan,
-    make: &impl Fn(&[ScreenVertex; 3]) -> Option<(T, [f32; 4])>,
-    vertices: &[ScreenVertex; 3],
+    made: Option<(T, [f32; 4])>,
     id: u32,
 ) -> Option<Piece<T>> {
-    let (tri, [x0, y0, x1, y1]) = make(vertices)?;
+    let (tri, [x0, y0, x1, y1]) = made?;
     let rect = PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height, span)?;
     Some(Piece { tri, rect, id })
 }
@@ -225,7 +277,7 @@ fn pieces_of<T>(
     }
     // 3. Fan-triangulate and set up each piece.
     for k in 1..poly.len - 1 {
-        pieces[k - 1] = piece(view, span, make, &[screen[0], screen[k], screen[k + 1]], id);
+        pieces[k - 1] = placed(view, span, make(&[screen[0], screen[k], screen[k + 1]]), id);
     }
     pieces
 }

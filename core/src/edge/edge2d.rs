@@ -54,61 +54,96 @@ impl Triangle2D {
         height: u32,
     ) -> Option<Triangle2D> {
         let w = v.map(|s| if affine { s.q } else { 1.0 / s.q });
-        let mut t = Triangle2D {
-            lo: [[0.0; 2]; 3],
-            delta: [[0.0; 2]; 3],
-            sign: [1.0; 3],
-            owns: [false; 3],
+        let w_range = [w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2])];
+        // 1. Canonical endpoints per edge (lexicographic on (x, y)).
+        let (mut lo, mut delta, mut sign) = ([[0.0; 2]; 3], [[0.0; 2]; 3], [1.0; 3]);
+        for i in 0..3 {
+            let a = v[(i + 1) % 3];
+            let b = v[(i + 2) % 3];
+            let (l, h, flip) = if (a.x, a.y) <= (b.x, b.y) {
+                (a, b, 1.0)
+            } else {
+                (b, a, -1.0)
+            };
+            lo[i] = [l.x, l.y];
+            delta[i] = [h.x - l.x, h.y - l.y];
+            sign[i] = flip;
+        }
+        if !(w_range[0].is_finite() && w_range[1].is_finite()) {
+            return None;
+        }
+        // 2. Orientation from edge 0 at its opposite vertex; the triangle is kept
+        //    only if every vertex is strictly inside its opposite edge.
+        let orientation = raw_edge(lo[0], delta[0], v[0].x, v[0].y) * sign[0];
+        if !(orientation != 0.0 && orientation.is_finite()) {
+            return None;
+        }
+        let orient = if orientation > 0.0 { 1.0 } else { -1.0 };
+        let mut error = [0.0; 3];
+        for (i, vertex) in v.iter().enumerate() {
+            sign[i] *= orient;
+            let inside = raw_edge(lo[i], delta[i], vertex.x, vertex.y) * sign[i];
+            if inside.is_nan() || inside <= 0.0 {
+                return None;
+            }
+            // Δx·(y − ly) − Δy·(x − lx) rounds five times, each by at most 2⁻²⁴ of
+            // the terms' magnitudes; 2⁻²⁰ leaves a margin.
+            let [lx, ly] = lo[i];
+            let [dx, dy] = delta[i];
+            let span = dx.abs() * (height as f32 + ly.abs()) + dy.abs() * (width as f32 + lx.abs());
+            error[i] = span * (1.0 / (1 << 20) as f32);
+        }
+        Some(Triangle2D::from_parts(
+            v,
+            affine,
+            w_range,
+            (lo, delta, sign),
+            error,
+        ))
+    }
+
+    /// The set-up triangle of vertices `v` from its edges (canonical starts,
+    /// `hi − lo` and signs, orientation applied), the range of its vertices'
+    /// `w` and its error bounds: the tie ownership and the bounds follow.
+    pub(super) fn from_parts(
+        v: &[ScreenVertex; 3],
+        affine: bool,
+        w_range: [f32; 2],
+        (lo, delta, sign): ([[f32; 2]; 3], [[f32; 2]; 3], [f32; 3]),
+        error: [f32; 3],
+    ) -> Triangle2D {
+        Triangle2D {
+            lo,
+            delta,
+            sign,
+            // ∂E/∂x = −Δy·s, ∂E/∂y = Δx·s.
+            owns: [0, 1, 2].map(|i| owns_tie(-delta[i][1] * sign[i], delta[i][0] * sign[i])),
             q: [v[0].q, v[1].q, v[2].q],
             affine,
-            w_range: [w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2])],
-            error: [0.0; 3],
+            w_range,
+            error,
             bounds: [
                 v[0].x.min(v[1].x).min(v[2].x),
                 v[0].y.min(v[1].y).min(v[2].y),
                 v[0].x.max(v[1].x).max(v[2].x),
                 v[0].y.max(v[1].y).max(v[2].y),
             ],
-        };
-        // 1. Canonical endpoints per edge (lexicographic on (x, y)).
-        for i in 0..3 {
-            let a = v[(i + 1) % 3];
-            let b = v[(i + 2) % 3];
-            let (lo, hi, flip) = if (a.x, a.y) <= (b.x, b.y) {
-                (a, b, 1.0)
-            } else {
-                (b, a, -1.0)
-            };
-            t.lo[i] = [lo.x, lo.y];
-            t.delta[i] = [hi.x - lo.x, hi.y - lo.y];
-            t.sign[i] = flip;
         }
-        if !(t.w_range[0].is_finite() && t.w_range[1].is_finite()) {
-            return None;
-        }
-        // 2. Orientation from edge 0 at its opposite vertex; the triangle is kept
-        //    only if every vertex is strictly inside its opposite edge.
-        let orientation = t.raw(0, v[0].x, v[0].y) * t.sign[0];
-        if !(orientation != 0.0 && orientation.is_finite()) {
-            return None;
-        }
-        let orient = if orientation > 0.0 { 1.0 } else { -1.0 };
-        for (i, vertex) in v.iter().enumerate() {
-            t.sign[i] *= orient;
-            let inside = t.raw(i, vertex.x, vertex.y) * t.sign[i];
-            if inside.is_nan() || inside <= 0.0 {
-                return None;
-            }
-            // ∂E/∂x = −Δy·s, ∂E/∂y = Δx·s.
-            t.owns[i] = owns_tie(-t.delta[i][1] * t.sign[i], t.delta[i][0] * t.sign[i]);
-            // Δx·(y − ly) − Δy·(x − lx) rounds five times, each by at most 2⁻²⁴ of
-            // the terms' magnitudes; 2⁻²⁰ leaves a margin.
-            let [lx, ly] = t.lo[i];
-            let [dx, dy] = t.delta[i];
-            let span = dx.abs() * (height as f32 + ly.abs()) + dy.abs() * (width as f32 + lx.abs());
-            t.error[i] = span * (1.0 / (1 << 20) as f32);
-        }
-        Some(t)
+    }
+
+    /// Every field's bits, to compare set-ups exactly.
+    #[cfg(test)]
+    pub(super) fn bits(&self) -> Vec<u32> {
+        let floats = (self.lo.iter().chain(&self.delta).flatten())
+            .chain(&self.sign)
+            .chain(&self.q)
+            .chain(&self.w_range)
+            .chain(&self.error)
+            .chain(&self.bounds);
+        (floats.map(|f| f.to_bits()))
+            .chain(self.owns.map(u32::from))
+            .chain([u32::from(self.affine)])
+            .collect()
     }
 
     /// The triangle as the GPU kernels read it (`Tri` in `gpu/compute.wgsl`,
@@ -142,10 +177,14 @@ impl Triangle2D {
     /// Canonical (unsigned) edge function `(hi − lo) × (p − lo)`.
     #[inline(always)]
     fn raw(&self, i: usize, x: f32, y: f32) -> f32 {
-        let [lx, ly] = self.lo[i];
-        let [dx, dy] = self.delta[i];
-        dx * (y - ly) - dy * (x - lx)
+        raw_edge(self.lo[i], self.delta[i], x, y)
     }
+}
+
+/// A canonical edge function `Δx·(y − ly) − Δy·(x − lx)` at `(x, y)`.
+#[inline(always)]
+fn raw_edge([lx, ly]: [f32; 2], [dx, dy]: [f32; 2], x: f32, y: f32) -> f32 {
+    dx * (y - ly) - dy * (x - lx)
 }
 
 /// The 8-lane forms of [`LinearEdges::edge_values`], the tie rule and

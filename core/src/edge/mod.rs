@@ -14,6 +14,7 @@
 
 mod curved;
 mod edge2d;
+mod edge2d_lanes;
 pub mod edge2d_fixed;
 mod edge3d;
 mod edge3d_f64;
@@ -24,6 +25,7 @@ mod homogeneous;
 pub use curved::CurvedTriangle;
 pub use edge2d::{ScreenVertex, Triangle2D};
 pub use edge2d_fixed::Triangle2DFixed;
+pub(crate) use edge2d_lanes::EightVertices;
 pub(crate) use edge3d::EPS;
 pub(crate) use edge3d::HomogeneousVertex;
 pub use edge3d::{Bound3D, Shared3D, Triangle3D};
