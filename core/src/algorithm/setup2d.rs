@@ -12,7 +12,9 @@ use crate::camera::View;
 use crate::clip::{
     ClipPlane, GUARD_BAND, MAX_CLIPPED, clip_triangle, fixed_guard_band, pipeline_planes,
 };
-use crate::edge::{EightVertices, ScreenVertex, Stored, Triangle2D, Triangle2DFixed};
+use crate::edge::{
+    EightVertices, ScreenVertex, Stored, Triangle2D, Triangle2DFixed, set_lane, vertices_of,
+};
 use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
@@ -25,9 +27,8 @@ pub(crate) fn setup_2d(
     span: SampleSpan,
 ) -> Setups<'static, Triangle2D> {
     let (affine, size) = (view.is_orthographic(), [view.width, view.height]);
-    let make_eight = move |v: &EightVertices, present: u8| {
-        let made = Triangle2D::setup_eight(v, present, affine, size[0], size[1]);
-        made.map(|t| t.map(|t| (t, t.bounds)))
+    let make_eight = move |v: &EightVertices, present: u8, out: &mut [Option<Triangle2D>; 8]| {
+        Triangle2D::setup_eight(v, present, affine, size, out);
     };
     setup_pieces(
         scene,
@@ -39,12 +40,27 @@ pub(crate) fn setup_2d(
     )
 }
 
-/// The f32 setup of one projected piece, with its vertex bounds.
-fn make_2d(view: &View) -> impl Fn(&[ScreenVertex; 3]) -> Option<(Triangle2D, [f32; 4])> + Sync {
+/// The f32 setup of one projected piece.
+fn make_2d(view: &View) -> impl Fn(&[ScreenVertex; 3]) -> Option<Triangle2D> + Sync {
     let affine = view.is_orthographic();
-    move |v| {
-        let t = Triangle2D::setup(v, affine, view.width, view.height)?;
-        Some((t, t.bounds))
+    move |v| Triangle2D::setup(v, affine, view.width, view.height)
+}
+
+/// A set-up projected triangle: its vertices' pixel bounds
+/// `[min_x, min_y, max_x, max_y]`.
+trait Projected: Stored<Shared<'static> = ()> {
+    fn bounds(&self) -> [f32; 4];
+}
+
+impl Projected for Triangle2D {
+    fn bounds(&self) -> [f32; 4] {
+        self.bounds
+    }
+}
+
+impl Projected for Triangle2DFixed {
+    fn bounds(&self) -> [f32; 4] {
+        self.bounds
     }
 }
 
@@ -57,24 +73,21 @@ pub(crate) fn setup_2d_fixed(
     span: SampleSpan,
 ) -> Setups<'static, Triangle2DFixed> {
     let affine = view.is_orthographic();
-    let make = move |v: &[ScreenVertex; 3]| {
-        let t = Triangle2DFixed::setup(v, affine)?;
-        Some((t, t.bounds))
-    };
-    let make_eight = move |v: &EightVertices, present: u8| {
-        std::array::from_fn(|l| match present >> l & 1 {
-            1 => make(&[v[0][l], v[1][l], v[2][l]]),
-            _ => None,
-        })
+    let make = move |v: &[ScreenVertex; 3]| Triangle2DFixed::setup(v, affine);
+    let make_eight = move |v: &EightVertices, present: u8, out: &mut [Option<_>; 8]| {
+        for (l, out) in out.iter_mut().enumerate() {
+            if present >> l & 1 == 1 {
+                *out = make(&vertices_of(v, l));
+            }
+        }
     };
     setup_pieces(scene, view, span, fixed_guard_band(view), make, make_eight)
 }
 
 /// Clips (the guard band `guard` in units of the half-extents), projects and
-/// fan-triangulates every drawable triangle; `make` sets up each piece and
-/// gives its pixel bounds `[min_x, min_y, max_x, max_y]`, and `make_eight`
-/// does what `make` does for the present lanes of eight unclipped triangles
-/// at once. One item per drawable triangle holds its first piece (exactly
+/// fan-triangulates every drawable triangle; `make` sets up each piece, and
+/// `make_eight` does what `make` does for the present lanes of eight
+/// unclipped triangles at once, into its third argument's lanes. One item per drawable triangle holds its first piece (exactly
 /// sized, parallel collects written in place, eight items at a time); the
 /// further pieces of the few triangles clipping cuts into several follow,
 /// set up again in a second, small pass.
@@ -84,13 +97,13 @@ pub(crate) fn setup_2d_fixed(
 /// every plane is its own clipped polygon and takes them as they are — the
 /// very values [`pieces_of`] would compute for it — while the others are
 /// clipped.
-fn setup_pieces<T: Stored<Shared<'static> = ()>>(
+fn setup_pieces<T: Projected>(
     scene: &PreparedScene,
     view: &View,
     span: SampleSpan,
     guard: [f32; 2],
-    make: impl Fn(&[ScreenVertex; 3]) -> Option<(T, [f32; 4])> + Sync,
-    make_eight: impl Fn(&EightVertices, u8) -> [Option<(T, [f32; 4])>; 8] + Sync,
+    make: impl Fn(&[ScreenVertex; 3]) -> Option<T> + Sync,
+    make_eight: impl Fn(&EightVertices, u8, &mut [Option<T>; 8]) + Sync,
 ) -> Setups<'static, T> {
     let planes = pipeline_planes(view, guard);
     let kept = screen_vertices(scene, view, &planes);
@@ -100,37 +113,33 @@ fn setup_pieces<T: Stored<Shared<'static> = ()>>(
         Some(Piece { tri, rect, id }) => (ItemBox::new(rect, id), Some(tri)),
         None => (ItemBox::NONE, None),
     };
-    let origin = ScreenVertex {
-        x: 0.0,
-        y: 0.0,
-        q: 0.0,
-    };
     let (first, more): (Columns<T>, Vec<u8>) = (scene.drawable.par_chunks(8))
         .map(|ids| {
             // The lanes whose three vertices are all kept, set up together.
-            let mut vertices: EightVertices = [[origin; 8]; 3];
+            let mut vertices: EightVertices = [[[0.0; 8]; 3]; 3];
             let mut unclipped = 0u8;
             for (l, &id) in ids.iter().enumerate() {
                 if let [Some(a), Some(b), Some(c)] = corners[id as usize].map(|v| kept[v as usize])
                 {
-                    [vertices[0][l], vertices[1][l], vertices[2][l]] = [a, b, c];
+                    set_lane(&mut vertices, l, [a, b, c]);
                     unclipped |= 1 << l;
                 }
             }
-            let mut made = make_eight(&vertices, unclipped).into_iter();
-            let (mut boxes, mut triangles) = ([ItemBox::NONE; 8], [const { None }; 8]);
-            let mut more = 0u8;
+            // Set up in place: each lane's triangle stays where it is made.
+            let mut triangles = [const { None }; 8];
+            make_eight(&vertices, unclipped, &mut triangles);
+            let (mut boxes, mut more) = ([ItemBox::NONE; 8], 0u8);
             for (l, &id) in ids.iter().enumerate() {
-                let made = made.next().flatten();
-                let first = if unclipped >> l & 1 == 1 {
-                    placed(view, span, made, id)
+                if unclipped >> l & 1 == 1 {
+                    match triangles[l].as_ref().and_then(|t| pixels(view, span, t)) {
+                        Some(rect) => boxes[l] = ItemBox::new(rect, id),
+                        None => triangles[l] = None,
+                    }
                 } else {
                     let mut pieces = pieces(id).into_iter().flatten();
-                    let first = pieces.next();
+                    (boxes[l], triangles[l]) = item(pieces.next());
                     more |= u8::from(pieces.next().is_some()) << l;
-                    first
-                };
-                (boxes[l], triangles[l]) = item(first);
+                }
             }
             ((boxes, triangles), more)
         })
@@ -235,28 +244,35 @@ fn screen_vertex(view: &View, c: DVec3) -> ScreenVertex {
     }
 }
 
-/// A piece of triangle `id` set up (with its bounds) with its pixels;
-/// `None` when it has no samples on screen.
+/// A set-up piece of triangle `id` with its pixels; `None` when it has no
+/// samples on screen.
 #[inline]
-fn placed<T>(
+fn placed<T: Projected>(
     view: &View,
     span: SampleSpan,
-    made: Option<(T, [f32; 4])>,
+    tri: Option<T>,
     id: u32,
 ) -> Option<Piece<T>> {
-    let (tri, [x0, y0, x1, y1]) = made?;
-    let rect = PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height, span)?;
+    let tri = tri?;
+    let rect = pixels(view, span, &tri)?;
     Some(Piece { tri, rect, id })
+}
+
+/// The pixels with a sample in `tri`'s bounds; `None` when none has.
+#[inline]
+fn pixels<T: Projected>(view: &View, span: SampleSpan, tri: &T) -> Option<PixelRect> {
+    let [x0, y0, x1, y1] = tri.bounds();
+    PixelRect::from_bounds(x0, y0, x1, y1, view.width, view.height, span)
 }
 
 /// The set-up pieces of triangle `id` after clipping and fan triangulation,
 /// in fan order (`None` where a piece has no samples on screen).
-fn pieces_of<T>(
+fn pieces_of<T: Projected>(
     scene: &PreparedScene,
     view: &View,
     span: SampleSpan,
     planes: &[ClipPlane],
-    make: &impl Fn(&[ScreenVertex; 3]) -> Option<(T, [f32; 4])>,
+    make: &impl Fn(&[ScreenVertex; 3]) -> Option<T>,
     id: u32,
 ) -> [Option<Piece<T>>; MAX_CLIPPED - 2] {
     let mut pieces: [Option<Piece<T>>; MAX_CLIPPED - 2] = std::array::from_fn(|_| None);

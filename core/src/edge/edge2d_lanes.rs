@@ -14,21 +14,42 @@
 use super::edge2d::{ScreenVertex, Triangle2D};
 use crate::simd::{self, Lanes, abs, finite};
 
-/// Eight triangles' vertices: vertex, lane.
-pub(crate) type EightVertices = [[ScreenVertex; 8]; 3];
+/// Eight triangles' vertices, coordinate by coordinate: `[x, y, q]`, then
+/// vertex, then lane (the lanes' layout: no transposition after).
+pub(crate) type EightVertices = [[[f32; 8]; 3]; 3];
+
+/// Lane `l`'s vertices.
+#[inline(always)]
+pub(crate) fn vertices_of(v: &EightVertices, l: usize) -> [ScreenVertex; 3] {
+    std::array::from_fn(|k| ScreenVertex {
+        x: v[0][k][l],
+        y: v[1][k][l],
+        q: v[2][k][l],
+    })
+}
+
+/// Puts `vertices` in lane `l` of `v`.
+#[inline(always)]
+pub(crate) fn set_lane(v: &mut EightVertices, l: usize, vertices: [ScreenVertex; 3]) {
+    for (k, s) in vertices.iter().enumerate() {
+        (v[0][k][l], v[1][k][l], v[2][k][l]) = (s.x, s.y, s.q);
+    }
+}
 
 impl Triangle2D {
-    /// The triangles of the lanes of `present` (vertex `k` of lane `l` at
-    /// `v[k][l]`), each exactly as [`Triangle2D::setup`] sets it up; `None`
-    /// in the other lanes.
+    /// Sets up the triangles of the lanes of `present` into `out` (lane `l`
+    /// into `out[l]`), each exactly as [`Triangle2D::setup`] sets it up;
+    /// the other lanes of `out` are left as they are. (In place: a set-up
+    /// triangle is written once, not moved.)
+    #[inline]
     pub(crate) fn setup_eight(
         v: &EightVertices,
         present: u8,
         affine: bool,
-        width: u32,
-        height: u32,
-    ) -> [Option<Triangle2D>; 8] {
-        setup_eight_with(v, present, affine, [width, height], edge_lanes)
+        [width, height]: [u32; 2],
+        out: &mut [Option<Triangle2D>; 8],
+    ) {
+        setup_eight_with(v, present, affine, [width, height], edge_lanes, out);
     }
 }
 
@@ -40,37 +61,39 @@ fn setup_eight_with(
     affine: bool,
     [width, height]: [u32; 2],
     kernel: fn(&EightVertices, [u32; 2]) -> LaneEdges,
-) -> [Option<Triangle2D>; 8] {
-    let vertices = |l: usize| [v[0][l], v[1][l], v[2][l]];
+    out: &mut [Option<Triangle2D>; 8],
+) {
     if present == 0 {
-        return [None; 8];
+        return;
     }
     let s = kernel(v, [width, height]);
-    std::array::from_fn(|l| {
+    for (l, out) in out.iter_mut().enumerate() {
         if present >> l & 1 == 0 {
-            return None;
+            continue;
         }
-        let v = vertices(l);
+        let v = vertices_of(v, l);
         if s.finite >> l & 1 == 0 {
-            return Triangle2D::setup(&v, affine, width, height);
+            *out = Triangle2D::setup(&v, affine, width, height);
+            continue;
         }
         // The scalar setup's three rejections, whichever it meets first.
         let w = v.map(|s| if affine { s.q } else { 1.0 / s.q });
         let w_range = [w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2])];
         if !(w_range[0].is_finite() && w_range[1].is_finite()) || s.kept >> l & 1 == 0 {
-            return None;
+            *out = None;
+            continue;
         }
         let lo = [0, 1, 2].map(|i| [s.lo[i][0][l], s.lo[i][1][l]]);
         let delta = [0, 1, 2].map(|i| [s.delta[i][0][l], s.delta[i][1][l]]);
         let sign = [0, 1, 2].map(|i| s.sign[i][l]);
-        Some(Triangle2D::from_parts(
+        *out = Some(Triangle2D::from_parts(
             &v,
             affine,
             w_range,
             (lo, delta, sign),
             [0, 1, 2].map(|i| s.error[i][l]),
-        ))
-    })
+        ));
+    }
 }
 
 /// What eight lanes of the setup computed, lane last.
@@ -102,9 +125,8 @@ fn edge_lanes_on<L: Lanes>(v: &EightVertices, [width, height]: [u32; 2]) -> Lane
     let (one, zero) = (L::splat(1.0), L::splat(0.0));
     let (mut x, mut y, mut all_finite) = ([zero; 3], [zero; 3], u8::MAX);
     for k in 0..3 {
-        let [xs, ys, qs] = coordinates(&v[k]);
-        (x[k], y[k]) = (L::from_array(xs), L::from_array(ys));
-        all_finite &= finite(x[k]) & finite(y[k]) & finite(L::from_array(qs));
+        (x[k], y[k]) = (L::from_array(v[0][k]), L::from_array(v[1][k]));
+        all_finite &= finite(x[k]) & finite(y[k]) & finite(L::from_array(v[2][k]));
     }
     // 1. Canonical endpoints per edge (lexicographic on (x, y); the lanes
     // compared are finite, where that is `a.x < b.x ∨ (a.x = b.x ∧ a.y ≤ b.y)`).
@@ -159,16 +181,6 @@ fn edge_lanes_on<L: Lanes>(v: &EightVertices, [width, height]: [u32; 2]) -> Lane
     out
 }
 
-/// Eight vertices' `x`, `y` and `q`, lane by lane.
-#[inline(always)]
-fn coordinates(v: &[ScreenVertex; 8]) -> [[f32; 8]; 3] {
-    let mut c = [[0.0; 8]; 3];
-    for (l, s) in v.iter().enumerate() {
-        (c[0][l], c[1][l], c[2][l]) = (s.x, s.y, s.q);
-    }
-    c
-}
-
 /// The canonical (unsigned) edge function `Δx·(y − ly) − Δy·(x − lx)` in lanes.
 #[inline(always)]
 fn raw_lanes<L: Lanes>([lx, ly]: [L; 2], [dx, dy]: [L; 2], x: L, y: L) -> L {
@@ -181,7 +193,19 @@ mod tests {
 
     /// Eight lanes of `triangles` (lane `l` its triangle `l`).
     fn lanes_of(triangles: &[[ScreenVertex; 3]; 8]) -> EightVertices {
-        std::array::from_fn(|k| std::array::from_fn(|l| triangles[l][k]))
+        let mut v = [[[0.0; 8]; 3]; 3];
+        for (l, &t) in triangles.iter().enumerate() {
+            set_lane(&mut v, l, t);
+            let bits = |t: [ScreenVertex; 3]| t.map(|s| [s.x, s.y, s.q].map(f32::to_bits));
+            assert_eq!(bits(vertices_of(&v, l)), bits(t));
+        }
+        v
+    }
+
+    /// A triangle every setup keeps.
+    fn unit_triangle() -> [ScreenVertex; 3] {
+        let at = |x, y| ScreenVertex { x, y, q: 1.0 };
+        [at(1.0, 1.0), at(9.0, 1.0), at(1.0, 9.0)]
     }
 
     /// Every lane of `kernel`'s eight-at-once setup equals the scalar setup
@@ -226,27 +250,27 @@ mod tests {
             let present = rng.u8(..);
             let affine = n % 5 == 0;
             let (width, height) = (200, 150);
-            let lanes = setup_eight_with(
-                &lanes_of(&triangles),
-                present,
-                affine,
-                [width, height],
-                kernel,
-            );
+            // A lane outside `present` keeps what it held.
+            let held = Triangle2D::setup(&unit_triangle(), false, width, height);
+            assert!(held.is_some());
+            let mut lanes = [held; 8];
+            let v = lanes_of(&triangles);
+            setup_eight_with(&v, present, affine, [width, height], kernel, &mut lanes);
             for (l, (lane, triangle)) in lanes.iter().zip(&triangles).enumerate() {
-                let scalar = (present >> l & 1 == 1)
-                    .then(|| Triangle2D::setup(triangle, affine, width, height))
-                    .flatten();
+                let scalar = match present >> l & 1 {
+                    1 => Triangle2D::setup(triangle, affine, width, height),
+                    _ => held,
+                };
                 assert_eq!(
                     lane.map(|t| t.bits()),
                     scalar.map(|t| t.bits()),
                     "triangle {n}, lane {l}: {triangle:?}"
                 );
                 checked += 1;
-                match scalar {
-                    Some(_) => set_up += 1,
-                    None if present >> l & 1 == 1 => rejected += 1,
-                    None => {}
+                match (present >> l & 1, scalar) {
+                    (1, Some(_)) => set_up += 1,
+                    (1, None) => rejected += 1,
+                    _ => {}
                 }
             }
         }
