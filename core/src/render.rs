@@ -53,8 +53,7 @@ impl RenderOutput {
     /// The hashes of the frame's ids, colours and samples, computed when
     /// asked: they check a render, they are not a part of it, so the render's
     /// clock ([`Stats::time_ms`]) does not run while they are taken (at 1080p
-    /// they read 16 MB that the resolve wrote past the cache, about 2 ms on
-    /// two cores).
+    /// they read 16 MB that the resolve wrote past the cache).
     pub fn hashes(&self) -> Hashes {
         Hashes::of(&self.framebuffer)
     }

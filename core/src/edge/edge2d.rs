@@ -53,8 +53,7 @@ impl Triangle2D {
         width: u32,
         height: u32,
     ) -> Option<Triangle2D> {
-        let w = v.map(|s| if affine { s.q } else { 1.0 / s.q });
-        let w_range = [w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2])];
+        let w_range = w_range(v, affine);
         // 1. Canonical endpoints per edge (lexicographic on (x, y)).
         let (mut lo, mut delta, mut sign) = ([[0.0; 2]; 3], [[0.0; 2]; 3], [1.0; 3]);
         for i in 0..3 {
@@ -179,6 +178,14 @@ impl Triangle2D {
     fn raw(&self, i: usize, x: f32, y: f32) -> f32 {
         raw_edge(self.lo[i], self.delta[i], x, y)
     }
+}
+
+/// The smallest and largest `w` of vertices `v` (`q` itself when `affine`,
+/// else `1/q`).
+#[inline(always)]
+pub(super) fn w_range(v: &[ScreenVertex; 3], affine: bool) -> [f32; 2] {
+    let w = v.map(|s| if affine { s.q } else { 1.0 / s.q });
+    [w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2])]
 }
 
 /// A canonical edge function `Δx·(y − ly) − Δy·(x − lx)` at `(x, y)`.

@@ -11,7 +11,7 @@
 //! the scalar setup computes it; a lane with a non-finite coordinate is set
 //! up by the scalar setup itself.
 
-use super::edge2d::{ScreenVertex, Triangle2D};
+use super::edge2d::{ScreenVertex, Triangle2D, w_range};
 use crate::simd::{self, Lanes, abs, finite};
 
 /// Eight triangles' vertices, coordinate by coordinate: `[x, y, q]`, then
@@ -77,8 +77,7 @@ fn setup_eight_with(
             continue;
         }
         // The scalar setup's three rejections, whichever it meets first.
-        let w = v.map(|s| if affine { s.q } else { 1.0 / s.q });
-        let w_range = [w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2])];
+        let w_range = w_range(&v, affine);
         if !(w_range[0].is_finite() && w_range[1].is_finite()) || s.kept >> l & 1 == 0 {
             *out = None;
             continue;
