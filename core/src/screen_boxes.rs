@@ -81,6 +81,32 @@ pub(crate) enum ImagePoint {
     Unsure,
 }
 
+impl ImagePoint {
+    /// The point as `[x, y, pad, kind]`: a projected point's values and kind
+    /// 0; NaN values and kind 1 (nearer) or 2 (unsure) for the others — so
+    /// that a lane's `x` alone says whether its point was projected (a
+    /// projected point's values are finite).
+    fn packed(self) -> [f32; 4] {
+        match self {
+            ImagePoint::Projected { x, y, pad } => [x, y, pad, 0.0],
+            ImagePoint::Nearer => [f32::NAN, f32::NAN, f32::NAN, 1.0],
+            ImagePoint::Unsure => [f32::NAN, f32::NAN, f32::NAN, 2.0],
+        }
+    }
+
+    /// The point [`ImagePoint::packed`] packed.
+    #[inline(always)]
+    fn unpacked([x, y, pad, kind]: [f32; 4]) -> ImagePoint {
+        if kind == 0.0 {
+            ImagePoint::Projected { x, y, pad }
+        } else if kind == 1.0 {
+            ImagePoint::Nearer
+        } else {
+            ImagePoint::Unsure
+        }
+    }
+}
+
 impl ImageMap {
     pub(crate) fn new(view: &View) -> ImageMap {
         let (columns, origin) = if view.is_orthographic() {
@@ -256,12 +282,8 @@ impl ImageMap {
         let pad = L::splat(8.0 * EPS) * magnitude + L::splat(1.0 / 1024.0);
         let size = [view.width, view.height];
         let mut rects = padded_rects([min_x, min_y, max_x, max_y], pad, size, span);
-        for (l, rect) in rects.iter_mut().enumerate() {
-            if beyond >> l & 1 == 0 {
-                *rect = None;
-            }
-        }
-        (rects, beyond & !all_finite)
+        rects.some &= beyond;
+        (rects.options(), beyond & !all_finite)
     }
 
     /// The box of the triangle `p` with vertex image points `points`: theirs
@@ -335,7 +357,9 @@ impl ImageMap {
 /// views' vertices projected once (not once per triangle using them).
 pub(crate) struct ScreenBoxes {
     map: Option<ImageMap>,
-    points: Vec<ImagePoint>,
+    /// Each mesh vertex's [`ImagePoint`] as four floats ([`ImagePoint::packed`]),
+    /// which a setup in lanes gathers.
+    pub(crate) points: Vec<[f32; 4]>,
 }
 
 impl ScreenBoxes {
@@ -350,13 +374,10 @@ impl ScreenBoxes {
             Some(map) => {
                 // Eight vertices at a time ([`points_eight`]); the last
                 // chunk's missing lanes repeat its last vertex and are cut.
-                let eights: Vec<[ImagePoint; 8]> = (positions.par_chunks(8))
+                let eights: Vec<[[f32; 4]; 8]> = (positions.par_chunks(8))
                     .map(|p| {
-                        points_eight(
-                            map,
-                            std::array::from_fn(|l| p[l.min(p.len() - 1)]),
-                            view.eye,
-                        )
+                        let corners = std::array::from_fn(|l| p[l.min(p.len() - 1)]);
+                        points_eight(map, corners, view.eye).map(ImagePoint::packed)
                     })
                     .collect();
                 let mut points = eights.into_flattened();
@@ -384,7 +405,7 @@ impl ScreenBoxes {
         let Some(map) = &self.map else {
             return sphere_rect(p, view, span);
         };
-        let points = vertices.map(|v| self.points[v as usize]);
+        let points = vertices.map(|v| ImagePoint::unpacked(self.points[v as usize]));
         map.image_box(p, &points, view)?.pixels(view, span)
     }
 
@@ -409,8 +430,12 @@ impl ScreenBoxes {
             // Non-planar views project nothing (`points` is empty).
             let mut all = self.map.is_some();
             for (k, &v) in vertices[l].iter().enumerate() {
-                match self.points.get(v as usize) {
-                    Some(&ImagePoint::Projected { x, y, pad }) => {
+                match self
+                    .points
+                    .get(v as usize)
+                    .map(|&p| ImagePoint::unpacked(p))
+                {
+                    Some(ImagePoint::Projected { x, y, pad }) => {
                         [points[0][k][l], points[1][k][l], points[2][k][l]] = [x, y, pad];
                     }
                     _ => all = false,
@@ -429,6 +454,52 @@ impl ScreenBoxes {
                     *rect = computed[l];
                 }
             }
+        }
+        rects
+    }
+
+    /// [`ScreenBoxes::rects_eight`] with the vertices in lanes: lane `l`'s
+    /// triangle has mesh vertices `vertices[k][l]` (every lane's index a
+    /// vertex; lanes outside `present` get `None`). The projected points
+    /// are gathered into lanes; a lane with a vertex not projected takes
+    /// [`ScreenBoxes::rect`]'s own path (with its corners from `positions`).
+    #[inline(always)]
+    pub(crate) fn rects_lanes<L: Lanes>(
+        &self,
+        vertices: &[[u32; 8]; 3],
+        present: u8,
+        positions: &[Vec3],
+        view: &View,
+        span: SampleSpan,
+    ) -> PixelRects {
+        let mut rects = PixelRects {
+            some: 0,
+            first: [[0.0; 8]; 2],
+            last: [[0.0; 8]; 2],
+        };
+        let mut projected = 0;
+        if self.map.is_some() {
+            let flat = self.points.as_flattened();
+            let points = [
+                gathered_point::<L>(flat, vertices[0]),
+                gathered_point::<L>(flat, vertices[1]),
+                gathered_point::<L>(flat, vertices[2]),
+            ];
+            // A point is projected where its x is finite.
+            projected =
+                present & finite(points[0][0]) & finite(points[1][0]) & finite(points[2][0]);
+            if projected != 0 {
+                rects = pixels_lanes(&points, [view.width, view.height], span);
+                rects.some &= projected;
+            }
+        }
+        let mut scalar = present & !projected;
+        while scalar != 0 {
+            let l = scalar.trailing_zeros() as usize;
+            scalar &= scalar - 1;
+            let v = [vertices[0][l], vertices[1][l], vertices[2][l]];
+            let rect = self.rect(&v.map(|v| positions[v as usize]), v, view, span);
+            rects.set(l, rect);
         }
         rects
     }
@@ -508,6 +579,17 @@ fn node_rects_eight_on<L: Lanes>(
         L::from_array(hi[2]),
     ];
     map.box_rects::<L>(&lo, &hi, view, span)
+}
+
+/// The packed points ([`ImagePoint::packed`]) of vertices `v`, one per lane,
+/// from the flat array of them: x, y and rounding bound.
+#[inline(always)]
+fn gathered_point<L: Lanes>(flat: &[f32], v: [u32; 8]) -> [L; 3] {
+    [
+        L::gather(flat, strided(v, 4, 0)),
+        L::gather(flat, strided(v, 4, 1)),
+        L::gather(flat, strided(v, 4, 2)),
+    ]
 }
 
 /// Eight triangles' projected vertices: x, y and rounding bound (as in
@@ -613,19 +695,53 @@ simd::dispatch! {
 #[inline(always)]
 fn pixels_eight_on<L: Lanes>(
     [xs, ys, pads]: &LanePoints,
-    [width, height]: [u32; 2],
+    size: [u32; 2],
     span: SampleSpan,
 ) -> [Option<PixelRect>; 8] {
-    let (mut min_x, mut min_y) = (L::from_array(xs[0]), L::from_array(ys[0]));
-    let (mut max_x, mut max_y) = (min_x, min_y);
-    let mut pad = L::splat(0.0).max(L::from_array(pads[0]));
-    for k in 1..3 {
-        let (x, y) = (L::from_array(xs[k]), L::from_array(ys[k]));
+    let points = [
+        [
+            L::from_array(xs[0]),
+            L::from_array(ys[0]),
+            L::from_array(pads[0]),
+        ],
+        [
+            L::from_array(xs[1]),
+            L::from_array(ys[1]),
+            L::from_array(pads[1]),
+        ],
+        [
+            L::from_array(xs[2]),
+            L::from_array(ys[2]),
+            L::from_array(pads[2]),
+        ],
+    ];
+    pixels_lanes(&points, size, span).options()
+}
+
+/// [`pixels_eight`] of points in lanes: per vertex, x, y and rounding bound.
+#[inline(always)]
+fn pixels_lanes<L: Lanes>(
+    points: &[[L; 3]; 3],
+    [width, height]: [u32; 2],
+    span: SampleSpan,
+) -> PixelRects {
+    let [x, y, pad] = points[0];
+    let (mut min_x, mut min_y, mut max_x, mut max_y) = (x, y, x, y);
+    let mut pad = L::splat(0.0).max(pad);
+    for &[x, y, p] in &points[1..] {
         (min_x, min_y) = (min_x.min(x), min_y.min(y));
         (max_x, max_y) = (max_x.max(x), max_y.max(y));
-        pad = pad.max(L::from_array(pads[k]));
+        pad = pad.max(p);
     }
     padded_rects([min_x, min_y, max_x, max_y], pad, [width, height], span)
+}
+
+/// Lane `l` of each of `index`'s lanes times `stride` plus `field`: where
+/// field `field` of record `index[l]` sits in a flat array of records of
+/// `stride` values. Callers keep `index · stride + field` below 2³².
+#[inline(always)]
+pub(crate) fn strided(index: [u32; 8], stride: u32, field: u32) -> [u32; 8] {
+    index.map(|i| i.wrapping_mul(stride).wrapping_add(field))
 }
 
 /// `r · v` for eight vectors `v` (per axis), as `Vec3::dot` rounds it:
@@ -652,7 +768,7 @@ fn padded_rects<L: Lanes>(
     pad: L,
     [width, height]: [u32; 2],
     span: SampleSpan,
-) -> [Option<PixelRect>; 8] {
+) -> PixelRects {
     let zero = L::splat(0.0);
     let x0 = ((min_x - pad) - L::splat(span.hi[0])).ceil().max(zero);
     let y0 = ((min_y - pad) - L::splat(span.hi[1])).ceil().max(zero);
@@ -660,20 +776,53 @@ fn padded_rects<L: Lanes>(
     let y1 = ((max_y + pad) - L::splat(span.lo[1])).floor();
     let x1 = x1.min(L::splat(width as f32 - 1.0));
     let y1 = y1.min(L::splat(height as f32 - 1.0));
-    let some = x0.le(x1) & y0.le(y1);
-    let [x0, y0, x1, y1] = [x0, y0, x1, y1].map(L::to_array);
-    let mut rects = [None; 8];
-    for (l, rect) in rects.iter_mut().enumerate() {
-        if some >> l & 1 == 1 {
-            *rect = Some(PixelRect {
-                x0: x0[l] as u32,
-                y0: y0[l] as u32,
-                x1: x1[l] as u32 + 1,
-                y1: y1[l] as u32 + 1,
-            });
+    PixelRects {
+        some: x0.le(x1) & y0.le(y1),
+        first: [x0.to_array(), y0.to_array()],
+        last: [x1.to_array(), y1.to_array()],
+    }
+}
+
+/// Eight pixel rects, one per lane, as lanes compute them: lane `l`'s, where
+/// bit `l` of `some` is set, holds the pixels `first[0][l]..=last[0][l]` by
+/// `first[1][l]..=last[1][l]` (whole numbers). Read lane by lane from the
+/// whole-register stores that made it (a rect built field by field and then
+/// copied whole waits for its stores to land).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PixelRects {
+    pub some: u8,
+    first: [[f32; 8]; 2],
+    last: [[f32; 8]; 2],
+}
+
+impl PixelRects {
+    /// Lane `l`'s rect.
+    #[inline(always)]
+    pub(crate) fn get(&self, l: usize) -> Option<PixelRect> {
+        (self.some >> l & 1 == 1).then(|| PixelRect {
+            x0: self.first[0][l] as u32,
+            y0: self.first[1][l] as u32,
+            x1: self.last[0][l] as u32 + 1,
+            y1: self.last[1][l] as u32 + 1,
+        })
+    }
+
+    /// Lane `l`'s rect becomes `rect` (pixel bounds are below 2¹⁶: exact in f32).
+    #[inline(always)]
+    fn set(&mut self, l: usize, rect: Option<PixelRect>) {
+        self.some &= !(1 << l);
+        if let Some(r) = rect {
+            self.some |= 1 << l;
+            (self.first[0][l], self.first[1][l]) = (r.x0 as f32, r.y0 as f32);
+            (self.last[0][l], self.last[1][l]) = ((r.x1 - 1) as f32, (r.y1 - 1) as f32);
         }
     }
-    rects
+
+    /// The eight rects.
+    #[inline(always)]
+    pub(crate) fn options(&self) -> [Option<PixelRect>; 8] {
+        std::array::from_fn(|l| self.get(l))
+    }
 }
 
 /// A box of image points, padded.

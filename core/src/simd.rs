@@ -81,6 +81,11 @@ mod sealed {
         /// Each lane truncated toward zero, as `f32 as u32` (for lanes in
         /// `[0, 2³¹)`: the only ones callers pass).
         fn truncate(self) -> [u32; 8];
+        /// `base[index[l]]` in lane `l`; panics, as indexing does, when an
+        /// index is out of bounds.
+        fn gather(base: &[f32], index: [u32; 8]) -> Self;
+        /// [`Ops::gather`] of `u32`s.
+        fn gather_u32(base: &[u32], index: [u32; 8]) -> [u32; 8];
     }
 }
 
@@ -159,6 +164,14 @@ impl sealed::Ops for Portable {
     #[inline(always)]
     fn truncate(self) -> [u32; 8] {
         self.to_array().map(|v| v as u32)
+    }
+    #[inline(always)]
+    fn gather(base: &[f32], index: [u32; 8]) -> Self {
+        Self::from_array(index.map(|i| base[i as usize]))
+    }
+    #[inline(always)]
+    fn gather_u32(base: &[u32], index: [u32; 8]) -> [u32; 8] {
+        index.map(|i| base[i as usize])
     }
 }
 
@@ -296,6 +309,42 @@ mod avx2_lanes {
             // SAFETY: `__m256i` and `[u32; 8]` are both 32 bytes.
             unsafe { std::mem::transmute::<__m256i, [u32; 8]>(v) }
         }
+        #[inline(always)]
+        fn gather(base: &[f32], index: [u32; 8]) -> Self {
+            let index = in_bounds(index, base.len());
+            // SAFETY: every lane's index is below `base.len()` (`in_bounds`
+            // panics otherwise), so each lane reads an element of `base`.
+            Avx2(unsafe { _mm256_i32gather_ps::<4>(base.as_ptr(), index) })
+        }
+        #[inline(always)]
+        fn gather_u32(base: &[u32], index: [u32; 8]) -> [u32; 8] {
+            let index = in_bounds(index, base.len());
+            // SAFETY: as in `gather`; `u32` and `i32` have one layout.
+            let v = unsafe { _mm256_i32gather_epi32::<4>(base.as_ptr().cast(), index) };
+            // SAFETY: `__m256i` and `[u32; 8]` are both 32 bytes.
+            unsafe { std::mem::transmute::<__m256i, [u32; 8]>(v) }
+        }
+    }
+
+    /// `index` as a register of i32 lanes, after checking that every lane is
+    /// below `len` (and so, with `len` capped at `i32::MAX`, a non-negative
+    /// i32: the gathers' offsets cannot wrap). Panics, as indexing does,
+    /// otherwise.
+    #[inline(always)]
+    fn in_bounds(index: [u32; 8], len: usize) -> __m256i {
+        // SAFETY: `[u32; 8]` and `__m256i` are both 32 bytes.
+        let v = unsafe { std::mem::transmute::<[u32; 8], __m256i>(index) };
+        let last = len.min(i32::MAX as usize).checked_sub(1);
+        let Some(last) = last else {
+            panic!("gather from an empty slice");
+        };
+        let last = avx!(_mm256_set1_epi32(last as i32));
+        // Every lane `≤ last` (unsigned): its minimum with `last` is itself.
+        let below = avx!(_mm256_cmpeq_epi32(_mm256_min_epu32(v, last), v));
+        if avx!(_mm256_movemask_epi8(below)) != -1 {
+            panic!("gather index out of bounds: {index:?} for length {len}");
+        }
+        v
     }
 }
 
@@ -403,4 +452,44 @@ pub(crate) fn prefetch<T: ?Sized>(value: &T) {
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = value;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    dispatch! {
+        /// The lanes' gathers of `index` from `f` and `u`.
+        fn gathered<>(f: &[f32], u: &[u32], index: [u32; 8]) -> ([f32; 8], [u32; 8]) => gathered_on
+    }
+
+    #[inline(always)]
+    fn gathered_on<L: Lanes>(f: &[f32], u: &[u32], index: [u32; 8]) -> ([f32; 8], [u32; 8]) {
+        (L::gather(f, index).to_array(), L::gather_u32(u, index))
+    }
+
+    /// Gathers read `base[index]` per lane on both paths, and panic on an
+    /// index out of bounds, the last one and `u32::MAX` included.
+    #[test]
+    fn gathers_read_their_indices_and_check_bounds() {
+        let f: Vec<f32> = (0..100).map(|i| i as f32 * 0.5).collect();
+        let u: Vec<u32> = (0..100).map(|i| i * 3).collect();
+        let index = [0, 99, 5, 5, 17, 64, 1, 98];
+        let expected = (index.map(|i| f[i as usize]), index.map(|i| u[i as usize]));
+        assert_eq!(gathered_on::<Portable>(&f, &u, index), expected);
+        assert_eq!(gathered(&f, &u, index), expected);
+        let mut checked = 0;
+        for bad in [100, 101, u32::MAX, 1 << 31] {
+            for lane in [0, 7] {
+                let mut index = index;
+                index[lane] = bad;
+                for path in [gathered_on::<Portable>, gathered] {
+                    let result = std::panic::catch_unwind(|| path(&f, &u, index));
+                    assert!(result.is_err(), "index {bad} in lane {lane} read");
+                    checked += 1;
+                }
+            }
+        }
+        assert_eq!(checked, 16);
+    }
 }

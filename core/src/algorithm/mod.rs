@@ -61,12 +61,11 @@ pub(crate) fn run(
     fb: &mut Framebuffer,
     stats: &mut Stats,
 ) -> Result<Option<Trace>, FieldError> {
-    let (view, pattern) = (context.view, context.pattern);
+    let (view, span) = (context.view, context.pattern.span);
     let f64 = precision == Precision::F64;
     let pass = match pipeline {
         Pipeline::AllTriangles { edges, samples } => {
             let start = Instant::now();
-            let span = pattern.span;
             // One generic call per edge kind (a closure cannot be generic),
             // each triangle rasterized by the box or hierarchy of `binning`,
             // or (`spans`, straight edges) by the sweep line of `scanline`.
@@ -126,33 +125,20 @@ pub(crate) fn run(
                 Triangle3D::setup,
             )
         }
-        Pipeline::Rays { packet } if view.sphere.is_some() => raycast::render_raycast(
-            scene,
-            context,
-            packet,
-            fb,
-            stats,
-            (),
-            setup3d::one_by_one(CurvedTriangle::setup),
-        ),
-        Pipeline::Rays { packet } if f64 => raycast::render_raycast(
-            scene,
-            context,
-            packet,
-            fb,
-            stats,
-            (),
-            setup3d::one_by_one(Triangle3D64::setup),
-        ),
-        Pipeline::Rays { packet } => raycast::render_raycast(
-            scene,
-            context,
-            packet,
-            fb,
-            stats,
-            setup3d::slot_shared_3d(scene, view),
-            Triangle3D::setup_eight,
-        ),
+        Pipeline::Rays { packet } if view.sphere.is_some() => {
+            let setup = setup3d::one_by_one(CurvedTriangle::setup);
+            let setups = || setup3d::setup_slots(scene, view, span, (), setup);
+            raycast::render_raycast(scene, context, packet, fb, stats, setups)
+        }
+        Pipeline::Rays { packet } if f64 => {
+            let setup = setup3d::one_by_one(Triangle3D64::setup);
+            let setups = || setup3d::setup_slots(scene, view, span, (), setup);
+            raycast::render_raycast(scene, context, packet, fb, stats, setups)
+        }
+        Pipeline::Rays { packet } => {
+            let setups = || setup3d::setup_slots_3d(scene, view, span);
+            raycast::render_raycast(scene, context, packet, fb, stats, setups)
+        }
         Pipeline::Gpu => render_gpu(scene, context, fb, stats)?,
         Pipeline::Compute(kind) => compute(scene, kind, context, fb, stats)?,
     };

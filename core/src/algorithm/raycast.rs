@@ -6,7 +6,6 @@
 
 use std::time::Instant;
 
-use super::setup3d::{self, SetupEight};
 use super::tiles::Setups;
 use super::{Pass, PixelRect, TileContext};
 use crate::aa::SamplePattern;
@@ -42,8 +41,7 @@ pub(crate) fn render_raycast<'a, T: Stored>(
     packet: u32,
     fb: &mut Framebuffer,
     stats: &mut Stats,
-    shared: T::Shared<'a>,
-    setup: impl SetupEight<'a, T>,
+    setup: impl FnOnce() -> Setups<'a, T>,
 ) -> Pass {
     let view = context.view;
     // 1. Setup: the 3D edge functions of every triangle with samples on
@@ -58,7 +56,7 @@ pub(crate) fn render_raycast<'a, T: Stored>(
     // (teapots: 94% of those with a box, 79% with a sample in a packet's
     // block), so little setup is saved.
     let start = Instant::now();
-    let setups = setup3d::setup_slots(scene, view, context.pattern.span, shared, setup);
+    let setups = setup();
     stats.triangle_setups = setups.placed();
     stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
 

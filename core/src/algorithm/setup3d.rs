@@ -13,8 +13,8 @@ use crate::edge::{
 use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
-use crate::screen_boxes::ScreenBoxes;
-use crate::simd;
+use crate::screen_boxes::{PixelRects, ScreenBoxes, strided};
+use crate::simd::{self, Lanes, first_lanes};
 
 /// Every drawable triangle with samples on screen, set up with 3D edge functions.
 pub(crate) fn setup_3d<'a>(
@@ -23,7 +23,161 @@ pub(crate) fn setup_3d<'a>(
     span: SampleSpan,
 ) -> Setups<'a, Triangle3D> {
     let shared = shared_3d(scene, view, false);
-    setup_visible(scene, view, span, shared, Triangle3D::setup_eight)
+    let mesh = &scene.scene.mesh;
+    if !LaneMesh::applies(view, &mesh.positions, &mesh.triangles) {
+        return setup_visible(scene, view, span, shared, Triangle3D::setup_eight);
+    }
+    let boxes = ScreenBoxes::new(scene, view);
+    let lanes = LaneMesh::new(&boxes, &mesh.positions, &mesh.triangles, view, span);
+    let eights = scene.drawable.par_chunks(8).map(|ids| {
+        // Eight ids are read in one load from where they lie (an array
+        // built lane by lane would be read back before its stores land); a
+        // last, shorter chunk repeats its last id.
+        let (rects, triangles) = match ids.try_into() {
+            Ok(eight) => setup_3d_eight(&lanes, Records::Listed(eight), 8),
+            Err(_) => {
+                let padded = lanes_of(ids).map(|&id| id);
+                setup_3d_eight(&lanes, Records::Listed(&padded), ids.len())
+            }
+        };
+        paired(|l| rects.get(l), lanes_of(ids), triangles)
+    });
+    flattened(eights.unzip(), scene.drawable.len(), shared)
+}
+
+/// [`setup_slots`] of [`Triangle3D`]s: every BVH slot's triangle set up
+/// with 3D edge functions, eight slots at a time in lanes where the view
+/// allows ([`setup_3d_eight`]).
+pub(crate) fn setup_slots_3d<'a>(
+    scene: &'a PreparedScene,
+    view: &'a View,
+    span: SampleSpan,
+) -> Setups<'a, Triangle3D> {
+    let shared = slot_shared_3d(scene, view);
+    let positions = &scene.scene.mesh.positions;
+    if !LaneMesh::applies(view, positions, &scene.slot_vertices) {
+        return setup_slots(scene, view, span, shared, Triangle3D::setup_eight);
+    }
+    let boxes = ScreenBoxes::new(scene, view);
+    let lanes = LaneMesh::new(&boxes, positions, &scene.slot_vertices, view, span);
+    let chunks = scene.slot_triangles.par_chunks(8).enumerate();
+    let eights = chunks.map(|(chunk, ids)| {
+        let records = Records::Run((chunk * 8) as u32);
+        let (rects, triangles) = setup_3d_eight(&lanes, records, ids.len());
+        paired(|l| rects.get(l), lanes_of(ids), triangles)
+    });
+    flattened(eights.unzip(), scene.slot_triangles.len(), shared)
+}
+
+/// What a perspective setup in lanes ([`setup_3d_eight`]) reads: the mesh's
+/// positions and vertex records (`[u32; 3]` per triangle) as flat arrays
+/// the lanes gather from, the vertices' projections, the view.
+struct LaneMesh<'a> {
+    positions: &'a [Vec3],
+    flat_positions: &'a [f32],
+    records: &'a [u32],
+    boxes: &'a ScreenBoxes,
+    view: &'a View,
+    span: SampleSpan,
+}
+
+impl<'a> LaneMesh<'a> {
+    /// Whether the lanes apply: a planar perspective view, and a mesh small
+    /// enough for 32-bit lane offsets into its flat arrays.
+    fn applies(view: &View, positions: &[Vec3], records: &[[u32; 3]]) -> bool {
+        let fits = |n: usize| n < (i32::MAX / 4) as usize;
+        view.sphere.is_none()
+            && !view.is_orthographic()
+            && fits(positions.len())
+            && fits(records.len())
+    }
+
+    fn new(
+        boxes: &'a ScreenBoxes,
+        positions: &'a [Vec3],
+        records: &'a [[u32; 3]],
+        view: &'a View,
+        span: SampleSpan,
+    ) -> LaneMesh<'a> {
+        debug_assert!(LaneMesh::applies(view, positions, records));
+        LaneMesh {
+            positions,
+            flat_positions: bytemuck::cast_slice(positions),
+            records: records.as_flattened(),
+            boxes,
+            view,
+            span,
+        }
+    }
+}
+
+/// Which vertex records eight lanes set up.
+#[derive(Clone, Copy, Debug)]
+enum Records<'a> {
+    /// These (lanes past the chunk's end repeat its last one).
+    Listed(&'a [u32; 8]),
+    /// Eight in a row from this one.
+    Run(u32),
+}
+
+simd::dispatch! {
+    /// The screen boxes and 3D setups of the first `n` (at least one) of
+    /// eight triangles with vertex records `records`, each exactly as [`rects_of`] and
+    /// [`Triangle3D::setup_eight`] make them: vertex indices, projected
+    /// points and corners gathered straight into lanes, with no per-lane
+    /// copies between the steps.
+    fn setup_3d_eight<>(
+        mesh: &LaneMesh,
+        records: Records,
+        n: usize,
+    ) -> (PixelRects, [Option<Triangle3D>; 8]) => setup_3d_eight_on
+}
+
+#[inline(always)]
+fn setup_3d_eight_on<L: Lanes>(
+    mesh: &LaneMesh,
+    records: Records,
+    n: usize,
+) -> (PixelRects, [Option<Triangle3D>; 8]) {
+    let items = match records {
+        Records::Listed(items) => *items,
+        // Past the end, the last record (`n ≥ 1`).
+        Records::Run(first) => std::array::from_fn(|l| first + (l as u32).min(n as u32 - 1)),
+    };
+    let vertices = [
+        L::gather_u32(mesh.records, strided(items, 3, 0)),
+        L::gather_u32(mesh.records, strided(items, 3, 1)),
+        L::gather_u32(mesh.records, strided(items, 3, 2)),
+    ];
+    let (view, span) = (mesh.view, mesh.span);
+    let rects =
+        (mesh.boxes).rects_lanes::<L>(&vertices, first_lanes(n), mesh.positions, view, span);
+    let present = rects.some;
+    // Off-screen triangles come in runs (the mesh's order is spatial):
+    // eight at once with no box skip the setup.
+    if present == 0 {
+        return (rects, [None; 8]);
+    }
+    let corners = [
+        corner_lanes::<L>(mesh.flat_positions, vertices[0]),
+        corner_lanes::<L>(mesh.flat_positions, vertices[1]),
+        corner_lanes::<L>(mesh.flat_positions, vertices[2]),
+    ];
+    let corners_of = |l: usize| vertices.map(|v| mesh.positions[v[l] as usize]);
+    (
+        rects,
+        Triangle3D::setup_lanes(&corners, present, view, corners_of),
+    )
+}
+
+/// The positions of vertices `v`, one per lane, per axis.
+#[inline(always)]
+fn corner_lanes<L: Lanes>(flat: &[f32], v: [u32; 8]) -> [L; 3] {
+    [
+        L::gather(flat, strided(v, 3, 0)),
+        L::gather(flat, strided(v, 3, 1)),
+        L::gather(flat, strided(v, 3, 2)),
+    ]
 }
 
 /// What the view's [`Triangle3D`]s share, set up by the 3D setup or the
@@ -121,7 +275,7 @@ pub(crate) fn setup_slots<'a, T: Stored>(
             present: 0,
         };
         let rects = rects_of(&boxes, &mut eight, p.len(), view, span);
-        paired(rects, lanes_of(ids), setup(&eight, view))
+        paired(|l| rects[l], lanes_of(ids), setup(&eight, view))
     });
     flattened(eights.unzip(), scene.slot_triangles.len(), shared)
 }
@@ -130,13 +284,13 @@ pub(crate) fn setup_slots<'a, T: Stored>(
 /// `None` in both where either is.
 #[inline(always)]
 fn paired<T>(
-    rects: [Option<PixelRect>; 8],
+    rects: impl Fn(usize) -> Option<PixelRect>,
     ids: [&u32; 8],
     mut triangles: [Option<T>; 8],
 ) -> ([ItemBox; 8], [Option<T>; 8]) {
     let mut boxes = [ItemBox::NONE; 8];
     for l in 0..8 {
-        match rects[l] {
+        match rects(l) {
             Some(rect) if triangles[l].is_some() => boxes[l] = ItemBox::new(rect, *ids[l]),
             _ => triangles[l] = None,
         }
@@ -213,7 +367,111 @@ fn setup_visible<'a, T: Stored>(
             present: 0,
         };
         let rects = rects_of(&boxes, &mut eight, ids.len(), view, span);
-        paired(rects, lanes_of(ids), setup(&eight, view))
+        paired(|l| rects[l], lanes_of(ids), setup(&eight, view))
     });
     flattened(eights.unzip(), scene.drawable.len(), shared)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::aa::{AaMode, SamplePattern};
+    use crate::{Camera, Viewport};
+
+    type Kernel = fn(&LaneMesh, Records, usize) -> (PixelRects, [Option<Triangle3D>; 8]);
+
+    /// `kernel` gives every lane the box and the set-up triangle that the
+    /// eight-at-a-time path gives ([`rects_of`], [`Triangle3D::setup_eight`],
+    /// each checked against the one-triangle forms), bit for bit: random
+    /// meshes of shared vertices on screen, off it, across the near plane
+    /// and behind the eye; listed and run records; full and short chunks.
+    fn lanes_match_the_eight_path(kernel: Kernel) {
+        let mut rng = fastrand::Rng::with_seed(31);
+        let (mut checked, mut set_up, mut scalar_boxes) = (0, 0, 0);
+        for case in 0..600 {
+            let eye = Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 4.0;
+            let camera = Camera {
+                name: "test".into(),
+                eye,
+                target: eye - Vec3::Z + Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, 0.0),
+                up: Vec3::Y,
+                viewport: Viewport::Perspective {
+                    fov_y_deg: [20.0, 60.0, 120.0][case % 3],
+                },
+                near: Some(0.1),
+            };
+            let size = (rng.u32(1..400), rng.u32(1..400));
+            let view = View::new(&camera, size.0, size.1, 0.1).expect("a valid camera");
+            let scale = [3.0, 0.05, 40.0][case / 3 % 3];
+            let positions: Vec<Vec3> = (0..40)
+                .map(|_| {
+                    let d = Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, 0.1 - rng.f32() * 1.2);
+                    eye + d * scale
+                })
+                .collect();
+            let records: Vec<[u32; 3]> = (0..64)
+                .map(|_| [rng.u32(0..40), rng.u32(0..40), rng.u32(0..40)])
+                .collect();
+            let span = SamplePattern::of([AaMode::None, AaMode::Ssaa(16)][case % 2]).span;
+            let boxes = ScreenBoxes::of(&positions, &view);
+            let mesh = LaneMesh::new(&boxes, &positions, &records, &view, span);
+            let n = rng.usize(1..=8);
+            let mut listed: [u32; 8] = std::array::from_fn(|_| rng.u32(0..64));
+            for l in n..8 {
+                listed[l] = listed[n - 1];
+            }
+            let first = rng.u32(0..=56);
+            let run = std::array::from_fn(|l| first + l.min(n - 1) as u32);
+            for (records_of, items) in [
+                (Records::Listed(&listed), listed),
+                (Records::Run(first), run),
+            ] {
+                let (rects, triangles) = kernel(&mesh, records_of, n);
+                let corners: [[Vec3; 3]; 8] =
+                    items.map(|i| records[i as usize].map(|v| positions[v as usize]));
+                let mut eight = EightTriangles {
+                    corners: std::array::from_fn(|l| &corners[l]),
+                    vertices: items.map(|i| records[i as usize]),
+                    present: 0,
+                };
+                let expected_rects = rects_of(&boxes, &mut eight, n, &view, span);
+                let expected = Triangle3D::setup_eight(&eight, &view);
+                for l in 0..8 {
+                    let at = format!("case {case}, lane {l} of {n}");
+                    assert_eq!(rects.get(l), expected_rects[l], "{at}");
+                    // Debug shows the sign of a zero, which `==` does not.
+                    assert_eq!(
+                        format!("{:?}", triangles[l]),
+                        format!("{:?}", expected[l]),
+                        "{at}"
+                    );
+                    checked += usize::from(l < n);
+                    set_up += usize::from(l < n && triangles[l].is_some());
+                    let projected =
+                        (0..3).all(|k| boxes.points[eight.vertices[l][k] as usize][0].is_finite());
+                    scalar_boxes += usize::from(l < n && !projected);
+                }
+            }
+        }
+        assert!(
+            checked > 4_000 && set_up > 1_000 && scalar_boxes > 500,
+            "{checked} lanes checked, {set_up} set up, {scalar_boxes} boxed by the scalar path"
+        );
+    }
+
+    #[test]
+    fn portable_lanes_set_up_as_eight_at_a_time() {
+        lanes_match_the_eight_path(setup_3d_eight_on::<simd::Portable>);
+    }
+
+    #[test]
+    fn avx2_lanes_set_up_as_eight_at_a_time() {
+        #[cfg(target_arch = "x86_64")]
+        assert!(
+            simd::cpu_has_avx2(),
+            "this test checks the AVX2 kernel, and this CPU has no AVX2"
+        );
+        // `setup_3d_eight` takes AVX2 where the CPU has it.
+        lanes_match_the_eight_path(setup_3d_eight);
+    }
 }

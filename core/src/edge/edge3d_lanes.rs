@@ -25,6 +25,23 @@ impl Triangle3D {
         setup_eight_with(t.corners, t.present, view, perspective_lanes)
     }
 
+    /// [`Triangle3D::setup_eight`] of perspective triangles whose corners
+    /// are in lanes already (per vertex, per axis), for the lanes of
+    /// `present`; `corners(l)` gives lane `l`'s corners to the scalar setup
+    /// where the lanes cannot decide.
+    #[inline(always)]
+    pub(crate) fn setup_lanes<L: Lanes>(
+        c: &[[L; 3]; 3],
+        present: u8,
+        view: &View,
+        corners: impl Fn(usize) -> [Vec3; 3],
+    ) -> [Option<Triangle3D>; 8] {
+        debug_assert!(!view.is_orthographic());
+        let [c0, c1, c2] = [V::of(c[0]), V::of(c[1]), V::of(c[2])];
+        let s = perspective_of(c0, c1, c2, view);
+        assembled(present, &s, |l| Triangle3D::setup(&corners(l), view))
+    }
+
     /// The triangles of `t` set up for homogeneous 2D rasterization from
     /// their transformed vertices (`points`, indexed by `t.vertices`), each
     /// exactly as [`setup_homogeneous_from`] sets it up.
@@ -167,6 +184,10 @@ struct V<L> {
 /// Glam's `Vec3` operations lane by lane, in its operation order.
 impl<L: Lanes> V<L> {
     #[inline(always)]
+    fn of([x, y, z]: [L; 3]) -> V<L> {
+        V { x, y, z }
+    }
+    #[inline(always)]
     fn load(c: &[[f32; 8]; 3]) -> V<L> {
         V {
             x: L::from_array(c[0]),
@@ -292,15 +313,24 @@ fn edge_lanes<L: Lanes>(a: V<L>, b: V<L>, sign: L, d_abs: Vec3, view: &View) -> 
 /// The lanes of [`Triangle3D::setup`]'s perspective branch, step for step.
 #[inline(always)]
 fn perspective_lanes_on<L: Lanes>(corners: &Corners, view: &View) -> LaneSetups {
+    let [c0, c1, c2] = [
+        V::load(&corners[0]),
+        V::load(&corners[1]),
+        V::load(&corners[2]),
+    ];
+    perspective_of::<L>(c0, c1, c2, view)
+}
+
+/// [`perspective_lanes_on`] of corners in lanes.
+#[inline(always)]
+fn perspective_of<L: Lanes>(c0: V<L>, c1: V<L>, c2: V<L>, view: &View) -> LaneSetups {
     // 1. Vertices relative to the eye, and their view-axis distances.
     let eye = V {
         x: L::splat(view.eye.x),
         y: L::splat(view.eye.y),
         z: L::splat(view.eye.z),
     };
-    let c0 = V::<L>::load(&corners[0]).sub(eye);
-    let c1 = V::<L>::load(&corners[1]).sub(eye);
-    let c2 = V::<L>::load(&corners[2]).sub(eye);
+    let (c0, c1, c2) = (c0.sub(eye), c1.sub(eye), c2.sub(eye));
     let w = [
         c0.dot_with(view.forward),
         c1.dot_with(view.forward),
