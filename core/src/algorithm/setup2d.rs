@@ -12,12 +12,12 @@ use crate::camera::View;
 use crate::clip::{
     ClipPlane, GUARD_BAND, MAX_CLIPPED, clip_triangle, fixed_guard_band, pipeline_planes,
 };
-use crate::edge::{
-    EightVertices, ScreenVertex, Stored, Triangle2D, Triangle2DFixed, set_lane, vertices_of,
-};
+use crate::edge::{EightVertices, ScreenVertex, Stored, Triangle2D, Triangle2DFixed, vertices_of};
 use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
+use crate::screen_boxes::strided;
+use crate::simd::{self, Lanes, first_lanes};
 
 /// Every drawable triangle, clipped, projected and set up with f32 edge
 /// functions; pieces without samples on screen are dropped.
@@ -107,7 +107,7 @@ fn setup_pieces<T: Projected>(
 ) -> Setups<'static, T> {
     let planes = pipeline_planes(view, guard);
     let kept = screen_vertices(scene, view, &planes);
-    let corners = &scene.scene.mesh.triangles;
+    let lanes = LaneVertices::new(&kept, &scene.scene.mesh.triangles);
     let pieces = |id: u32| pieces_of(scene, view, span, &planes, &make, id);
     let item = |piece: Option<Piece<T>>| match piece {
         Some(Piece { tri, rect, id }) => (ItemBox::new(rect, id), Some(tri)),
@@ -116,15 +116,15 @@ fn setup_pieces<T: Projected>(
     let (first, more): (Columns<T>, Vec<u8>) = (scene.drawable.par_chunks(8))
         .map(|ids| {
             // The lanes whose three vertices are all kept, set up together.
-            let mut vertices: EightVertices = [[[0.0; 8]; 3]; 3];
-            let mut unclipped = 0u8;
-            for (l, &id) in ids.iter().enumerate() {
-                if let [Some(a), Some(b), Some(c)] = corners[id as usize].map(|v| kept[v as usize])
-                {
-                    set_lane(&mut vertices, l, [a, b, c]);
-                    unclipped |= 1 << l;
+            // Eight ids are read in one load from where they lie; a last,
+            // shorter chunk repeats its last id.
+            let (vertices, unclipped) = match ids.try_into() {
+                Ok(eight) => kept_eight(&lanes, eight, 8),
+                Err(_) => {
+                    let padded = std::array::from_fn(|l| ids[l.min(ids.len() - 1)]);
+                    kept_eight(&lanes, &padded, ids.len())
                 }
-            }
+            };
             // Set up in place: each lane's triangle stays where it is made.
             let mut triangles = [const { None }; 8];
             make_eight(&vertices, unclipped, &mut triangles);
@@ -208,23 +208,64 @@ struct Piece<T> {
     id: u32,
 }
 
-/// Per mesh vertex: its projection when it is inside every clip plane (`None`
-/// when some plane would clip it).
-fn screen_vertices(
-    scene: &PreparedScene,
-    view: &View,
-    planes: &[ClipPlane],
-) -> Vec<Option<ScreenVertex>> {
+/// Per mesh vertex, `[x, y, q, kept]`: its projection and 1 when it is inside
+/// every clip plane, zeros when some plane would clip it — the layout the
+/// lanes gather ([`kept_eight`]).
+fn screen_vertices(scene: &PreparedScene, view: &View, planes: &[ClipPlane]) -> Vec<[f32; 4]> {
     let positions = &scene.scene.mesh.positions;
     (positions.par_iter())
         .map(|&p| {
             let c = view.to_camera_f64(p);
-            planes
-                .iter()
-                .all(|plane| plane.keeps(c))
-                .then(|| screen_vertex(view, c))
+            match planes.iter().all(|plane| plane.keeps(c)) {
+                true => {
+                    let s = screen_vertex(view, c);
+                    [s.x, s.y, s.q, 1.0]
+                }
+                false => [0.0; 4],
+            }
         })
         .collect()
+}
+
+/// What [`kept_eight`] gathers from: the projected vertices and the
+/// triangles' vertex records, flat.
+struct LaneVertices<'a> {
+    points: &'a [f32],
+    records: &'a [u32],
+}
+
+impl<'a> LaneVertices<'a> {
+    fn new(points: &'a [[f32; 4]], records: &'a [[u32; 3]]) -> LaneVertices<'a> {
+        // 32-bit lane offsets (a mesh of a quarter billion vertices would
+        // not fit in memory anyway).
+        assert!(points.len() < (i32::MAX / 4) as usize && records.len() < (i32::MAX / 3) as usize);
+        LaneVertices {
+            points: points.as_flattened(),
+            records: records.as_flattened(),
+        }
+    }
+}
+
+simd::dispatch! {
+    /// The vertices of the first `n` of triangles `ids` in lanes (lanes
+    /// past `n` repeat a triangle), and the lanes whose three vertices are
+    /// all kept: gathered, and stored a whole lane group at a time, which is
+    /// how the setup's lanes read them back.
+    fn kept_eight<>(lanes: &LaneVertices, ids: &[u32; 8], n: usize) -> (EightVertices, u8) => kept_eight_on
+}
+
+#[inline(always)]
+fn kept_eight_on<L: Lanes>(lanes: &LaneVertices, ids: &[u32; 8], n: usize) -> (EightVertices, u8) {
+    let mut v: EightVertices = [[[0.0; 8]; 3]; 3];
+    let mut kept = first_lanes(n);
+    for k in 0..3 {
+        let vertex = L::gather_u32(lanes.records, strided(*ids, 3, k as u32));
+        for (c, coordinate) in v.iter_mut().enumerate() {
+            coordinate[k] = L::gather(lanes.points, strided(vertex, 4, c as u32)).to_array();
+        }
+        kept &= L::gather(lanes.points, strided(vertex, 4, 3)).eq(L::splat(1.0));
+    }
+    (v, kept)
 }
 
 /// A camera-space point projected to the image, with its depth quantity
@@ -296,4 +337,71 @@ fn pieces_of<T: Projected>(
         pieces[k - 1] = placed(view, span, make(&[screen[0], screen[k], screen[k + 1]]), id);
     }
     pieces
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    type Gather = fn(&LaneVertices, &[u32; 8], usize) -> (EightVertices, u8);
+
+    /// `gather` gives each of the first `n` lanes its triangle's vertices
+    /// (bit for bit) and marks it kept exactly when its three vertices are:
+    /// random points, about one in five clipped, random triangles, full and
+    /// short chunks.
+    fn lanes_hold_the_kept_vertices(gather: Gather) {
+        let mut rng = fastrand::Rng::with_seed(7);
+        let (mut checked, mut kept_lanes) = (0, 0);
+        for case in 0..2_000 {
+            let points: Vec<[f32; 4]> = (0..30)
+                .map(|_| match rng.u32(0..5) {
+                    0 => [0.0; 4],
+                    _ => [rng.f32() * 99.0, rng.f32() * -7.0, rng.f32(), 1.0],
+                })
+                .collect();
+            let records: Vec<[u32; 3]> = (0..40)
+                .map(|_| [rng.u32(0..30), rng.u32(0..30), rng.u32(0..30)])
+                .collect();
+            let n = rng.usize(1..=8);
+            let mut ids: [u32; 8] = std::array::from_fn(|_| rng.u32(0..40));
+            for l in n..8 {
+                ids[l] = ids[n - 1];
+            }
+            let (v, kept) = gather(&LaneVertices::new(&points, &records), &ids, n);
+            for l in 0..n {
+                let corners = records[ids[l] as usize].map(|i| points[i as usize]);
+                let all = corners.iter().all(|p| p[3] == 1.0);
+                assert_eq!(kept >> l & 1 == 1, all, "case {case}, lane {l} of {n}");
+                let lane = vertices_of(&v, l).map(|s| [s.x, s.y, s.q].map(f32::to_bits));
+                let expected = corners.map(|p| [p[0], p[1], p[2]].map(f32::to_bits));
+                assert_eq!(lane, expected, "case {case}, lane {l} of {n}");
+                (checked, kept_lanes) = (checked + 1, kept_lanes + usize::from(all));
+            }
+            assert_eq!(
+                u32::from(kept) >> n,
+                0,
+                "case {case}: no lane past {n} is kept"
+            );
+        }
+        assert!(
+            checked > 5_000 && kept_lanes > 2_000,
+            "{checked} lanes, {kept_lanes} kept"
+        );
+    }
+
+    #[test]
+    fn portable_lanes_hold_the_kept_vertices() {
+        lanes_hold_the_kept_vertices(kept_eight_on::<simd::Portable>);
+    }
+
+    #[test]
+    fn avx2_lanes_hold_the_kept_vertices() {
+        #[cfg(target_arch = "x86_64")]
+        assert!(
+            simd::cpu_has_avx2(),
+            "this test checks the AVX2 kernel, and this CPU has no AVX2"
+        );
+        // `kept_eight` takes AVX2 where the CPU has it.
+        lanes_hold_the_kept_vertices(kept_eight);
+    }
 }

@@ -104,6 +104,7 @@ impl Triangle2D {
     /// The set-up triangle of vertices `v` from its edges (canonical starts,
     /// `hi − lo` and signs, orientation applied), the range of its vertices'
     /// `w` and its error bounds: the tie ownership and the bounds follow.
+    #[inline(always)]
     pub(super) fn from_parts(
         v: &[ScreenVertex; 3],
         affine: bool,

@@ -29,8 +29,8 @@ pub(crate) fn vertices_of(v: &EightVertices, l: usize) -> [ScreenVertex; 3] {
 }
 
 /// Puts `vertices` in lane `l` of `v`.
-#[inline(always)]
-pub(crate) fn set_lane(v: &mut EightVertices, l: usize, vertices: [ScreenVertex; 3]) {
+#[cfg(test)]
+fn set_lane(v: &mut EightVertices, l: usize, vertices: [ScreenVertex; 3]) {
     for (k, s) in vertices.iter().enumerate() {
         (v[0][k][l], v[1][k][l], v[2][k][l]) = (s.x, s.y, s.q);
     }

@@ -25,7 +25,7 @@ mod homogeneous;
 pub use curved::CurvedTriangle;
 pub use edge2d::{ScreenVertex, Triangle2D};
 pub use edge2d_fixed::Triangle2DFixed;
-pub(crate) use edge2d_lanes::{EightVertices, set_lane, vertices_of};
+pub(crate) use edge2d_lanes::{EightVertices, vertices_of};
 pub(crate) use edge3d::EPS;
 pub(crate) use edge3d::HomogeneousVertex;
 pub use edge3d::{Bound3D, Shared3D, Triangle3D};
