@@ -720,7 +720,7 @@ fn pixels_eight_on<L: Lanes>(
 
 /// [`pixels_eight`] of points in lanes: per vertex, x, y and rounding bound.
 #[inline(always)]
-fn pixels_lanes<L: Lanes>(
+pub(crate) fn pixels_lanes<L: Lanes>(
     points: &[[L; 3]; 3],
     [width, height]: [u32; 2],
     span: SampleSpan,

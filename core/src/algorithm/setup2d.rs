@@ -16,8 +16,8 @@ use crate::edge::{EightVertices, ScreenVertex, Stored, Triangle2D, Triangle2DFix
 use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
-use crate::screen_boxes::strided;
-use crate::simd::{self, Lanes, first_lanes};
+use crate::screen_boxes::{PixelRects, pixels_lanes, strided};
+use crate::simd::{self, Lanes, finite, first_lanes};
 
 /// Every drawable triangle, clipped, projected and set up with f32 edge
 /// functions; pieces without samples on screen are dropped.
@@ -49,16 +49,21 @@ fn make_2d(view: &View) -> impl Fn(&[ScreenVertex; 3]) -> Option<Triangle2D> + S
 /// A set-up projected triangle: its vertices' pixel bounds
 /// `[min_x, min_y, max_x, max_y]`.
 trait Projected: Stored<Shared<'static> = ()> {
+    /// Whether the bounds are those of the vertices the setup was given
+    /// (so that [`kept_eight`]'s rects are the triangle's pixels).
+    const BOUNDS_OF_VERTICES: bool;
     fn bounds(&self) -> [f32; 4];
 }
 
 impl Projected for Triangle2D {
+    const BOUNDS_OF_VERTICES: bool = true;
     fn bounds(&self) -> [f32; 4] {
         self.bounds
     }
 }
 
 impl Projected for Triangle2DFixed {
+    const BOUNDS_OF_VERTICES: bool = false;
     fn bounds(&self) -> [f32; 4] {
         self.bounds
     }
@@ -107,7 +112,8 @@ fn setup_pieces<T: Projected>(
 ) -> Setups<'static, T> {
     let planes = pipeline_planes(view, guard);
     let kept = screen_vertices(scene, view, &planes);
-    let lanes = LaneVertices::new(&kept, &scene.scene.mesh.triangles);
+    let size = [view.width, view.height];
+    let lanes = LaneVertices::new(&kept, &scene.scene.mesh.triangles, size, span);
     let pieces = |id: u32| pieces_of(scene, view, span, &planes, &make, id);
     let item = |piece: Option<Piece<T>>| match piece {
         Some(Piece { tri, rect, id }) => (ItemBox::new(rect, id), Some(tri)),
@@ -118,20 +124,25 @@ fn setup_pieces<T: Projected>(
             // The lanes whose three vertices are all kept, set up together.
             // Eight ids are read in one load from where they lie; a last,
             // shorter chunk repeats its last id.
-            let (vertices, unclipped) = match ids.try_into() {
+            let eight = match ids.try_into() {
                 Ok(eight) => kept_eight(&lanes, eight, 8),
                 Err(_) => {
                     let padded = std::array::from_fn(|l| ids[l.min(ids.len() - 1)]);
                     kept_eight(&lanes, &padded, ids.len())
                 }
             };
+            let unclipped = eight.kept;
             // Set up in place: each lane's triangle stays where it is made.
             let mut triangles = [const { None }; 8];
-            make_eight(&vertices, unclipped, &mut triangles);
+            make_eight(&eight.vertices, unclipped, &mut triangles);
             let (mut boxes, mut more) = ([ItemBox::NONE; 8], 0u8);
             for (l, &id) in ids.iter().enumerate() {
                 if unclipped >> l & 1 == 1 {
-                    match triangles[l].as_ref().and_then(|t| pixels(view, span, t)) {
+                    let rect = |t: &T| match T::BOUNDS_OF_VERTICES && eight.bounded >> l & 1 == 1 {
+                        true => eight.rects.get(l),
+                        false => pixels(view, span, t),
+                    };
+                    match triangles[l].as_ref().and_then(rect) {
                         Some(rect) => boxes[l] = ItemBox::new(rect, id),
                         None => triangles[l] = None,
                     }
@@ -232,16 +243,25 @@ fn screen_vertices(scene: &PreparedScene, view: &View, planes: &[ClipPlane]) -> 
 struct LaneVertices<'a> {
     points: &'a [f32],
     records: &'a [u32],
+    size: [u32; 2],
+    span: SampleSpan,
 }
 
 impl<'a> LaneVertices<'a> {
-    fn new(points: &'a [[f32; 4]], records: &'a [[u32; 3]]) -> LaneVertices<'a> {
+    fn new(
+        points: &'a [[f32; 4]],
+        records: &'a [[u32; 3]],
+        size: [u32; 2],
+        span: SampleSpan,
+    ) -> LaneVertices<'a> {
         // 32-bit lane offsets (a mesh of a quarter billion vertices would
         // not fit in memory anyway).
         assert!(points.len() < (i32::MAX / 4) as usize && records.len() < (i32::MAX / 3) as usize);
         LaneVertices {
             points: points.as_flattened(),
             records: records.as_flattened(),
+            size,
+            span,
         }
     }
 }
@@ -251,21 +271,47 @@ simd::dispatch! {
     /// past `n` repeat a triangle), and the lanes whose three vertices are
     /// all kept: gathered, and stored a whole lane group at a time, which is
     /// how the setup's lanes read them back.
-    fn kept_eight<>(lanes: &LaneVertices, ids: &[u32; 8], n: usize) -> (EightVertices, u8) => kept_eight_on
+    fn kept_eight<>(lanes: &LaneVertices, ids: &[u32; 8], n: usize) -> KeptEight => kept_eight_on
 }
 
 #[inline(always)]
-fn kept_eight_on<L: Lanes>(lanes: &LaneVertices, ids: &[u32; 8], n: usize) -> (EightVertices, u8) {
+fn kept_eight_on<L: Lanes>(lanes: &LaneVertices, ids: &[u32; 8], n: usize) -> KeptEight {
     let mut v: EightVertices = [[[0.0; 8]; 3]; 3];
     let mut kept = first_lanes(n);
+    let zero = L::splat(0.0);
+    // Per vertex: x, y and a pad of zero (the bounds are the vertices').
+    let mut points = [[zero; 3]; 3];
+    let mut finite_xy = u8::MAX;
     for k in 0..3 {
         let vertex = L::gather_u32(lanes.records, strided(*ids, 3, k as u32));
-        for (c, coordinate) in v.iter_mut().enumerate() {
-            coordinate[k] = L::gather(lanes.points, strided(vertex, 4, c as u32)).to_array();
-        }
+        let x = L::gather(lanes.points, strided(vertex, 4, 0));
+        let y = L::gather(lanes.points, strided(vertex, 4, 1));
+        let q = L::gather(lanes.points, strided(vertex, 4, 2));
+        (v[0][k], v[1][k], v[2][k]) = (x.to_array(), y.to_array(), q.to_array());
+        points[k] = [x, y, zero];
+        finite_xy &= finite(x) & finite(y);
         kept &= L::gather(lanes.points, strided(vertex, 4, 3)).eq(L::splat(1.0));
     }
-    (v, kept)
+    KeptEight {
+        vertices: v,
+        kept,
+        rects: pixels_lanes(&points, lanes.size, lanes.span),
+        bounded: kept & finite_xy,
+    }
+}
+
+/// A chunk's vertices as [`kept_eight`] gathers them.
+struct KeptEight {
+    vertices: EightVertices,
+    /// The lanes whose three vertices are kept.
+    kept: u8,
+    /// In the lanes of `bounded`, the pixels with a sample in the box of the
+    /// lane's vertices: [`PixelRect::from_bounds`] of a [`Triangle2D`]'s
+    /// bounds (the lanes' `minps`/`maxps` differ from `f32::min`/`max`
+    /// only in the sign of a zero, which the pixels do not see).
+    rects: PixelRects,
+    /// Kept lanes whose coordinates are finite.
+    bounded: u8,
 }
 
 /// A camera-space point projected to the image, with its depth quantity
@@ -342,21 +388,34 @@ fn pieces_of<T: Projected>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::aa::{AaMode, SamplePattern};
 
-    type Gather = fn(&LaneVertices, &[u32; 8], usize) -> (EightVertices, u8);
+    type Gather = fn(&LaneVertices, &[u32; 8], usize) -> KeptEight;
 
     /// `gather` gives each of the first `n` lanes its triangle's vertices
-    /// (bit for bit) and marks it kept exactly when its three vertices are:
-    /// random points, about one in five clipped, random triangles, full and
-    /// short chunks.
+    /// (bit for bit), marks it kept exactly when its three vertices are, and
+    /// gives a kept lane with finite coordinates the pixels of its
+    /// vertices' box as `PixelRect::from_bounds` finds them: random points
+    /// on and off the image, about one in five clipped and one in forty
+    /// not finite, random triangles and sample spans, full and short chunks.
     fn lanes_hold_the_kept_vertices(gather: Gather) {
         let mut rng = fastrand::Rng::with_seed(7);
-        let (mut checked, mut kept_lanes) = (0, 0);
+        let (mut checked, mut kept_lanes, mut with_pixels) = (0, 0, 0);
         for case in 0..2_000 {
+            let coordinate = |rng: &mut fastrand::Rng, scale: f32| match rng.u32(0..80) {
+                0 => f32::INFINITY,
+                1 => f32::NAN,
+                _ => rng.f32() * scale - 20.0,
+            };
             let points: Vec<[f32; 4]> = (0..30)
                 .map(|_| match rng.u32(0..5) {
                     0 => [0.0; 4],
-                    _ => [rng.f32() * 99.0, rng.f32() * -7.0, rng.f32(), 1.0],
+                    _ => [
+                        coordinate(&mut rng, 140.0),
+                        coordinate(&mut rng, 90.0),
+                        0.5,
+                        1.0,
+                    ],
                 })
                 .collect();
             let records: Vec<[u32; 3]> = (0..40)
@@ -367,25 +426,44 @@ mod tests {
             for l in n..8 {
                 ids[l] = ids[n - 1];
             }
-            let (v, kept) = gather(&LaneVertices::new(&points, &records), &ids, n);
+            let size = [rng.u32(1..120), rng.u32(1..80)];
+            let aa = [AaMode::None, AaMode::Ssaa(4), AaMode::Msaa(8)][case % 3];
+            let span = SamplePattern::of(aa).span;
+            let lanes = LaneVertices::new(&points, &records, size, span);
+            let eight = gather(&lanes, &ids, n);
             for l in 0..n {
                 let corners = records[ids[l] as usize].map(|i| points[i as usize]);
                 let all = corners.iter().all(|p| p[3] == 1.0);
-                assert_eq!(kept >> l & 1 == 1, all, "case {case}, lane {l} of {n}");
-                let lane = vertices_of(&v, l).map(|s| [s.x, s.y, s.q].map(f32::to_bits));
+                let at = format!("case {case}, lane {l} of {n}");
+                assert_eq!(eight.kept >> l & 1 == 1, all, "{at}");
+                let lane =
+                    vertices_of(&eight.vertices, l).map(|s| [s.x, s.y, s.q].map(f32::to_bits));
                 let expected = corners.map(|p| [p[0], p[1], p[2]].map(f32::to_bits));
-                assert_eq!(lane, expected, "case {case}, lane {l} of {n}");
+                assert_eq!(lane, expected, "{at}");
+                let finite = corners.iter().all(|p| p[0].is_finite() && p[1].is_finite());
+                assert_eq!(eight.bounded >> l & 1 == 1, all && finite, "{at}");
+                if all && finite {
+                    let (x, y) = (corners.map(|p| p[0]), corners.map(|p| p[1]));
+                    let expected = PixelRect::from_bounds(
+                        x[0].min(x[1]).min(x[2]),
+                        y[0].min(y[1]).min(y[2]),
+                        x[0].max(x[1]).max(x[2]),
+                        y[0].max(y[1]).max(y[2]),
+                        size[0],
+                        size[1],
+                        span,
+                    );
+                    assert_eq!(eight.rects.get(l), expected, "{at}");
+                    with_pixels += usize::from(expected.is_some());
+                }
                 (checked, kept_lanes) = (checked + 1, kept_lanes + usize::from(all));
             }
-            assert_eq!(
-                u32::from(kept) >> n,
-                0,
-                "case {case}: no lane past {n} is kept"
-            );
+            let past = u32::from(eight.kept | eight.bounded) >> n;
+            assert_eq!(past, 0, "case {case}: no lane past {n} is kept");
         }
         assert!(
-            checked > 5_000 && kept_lanes > 2_000,
-            "{checked} lanes, {kept_lanes} kept"
+            checked > 5_000 && kept_lanes > 2_000 && with_pixels > 1_000,
+            "{checked} lanes, {kept_lanes} kept, {with_pixels} with pixels"
         );
     }
 
