@@ -254,9 +254,14 @@ impl<'a> LaneVertices<'a> {
         size: [u32; 2],
         span: SampleSpan,
     ) -> LaneVertices<'a> {
-        // 32-bit lane offsets (a mesh of a quarter billion vertices would
-        // not fit in memory anyway).
-        assert!(points.len() < (i32::MAX / 4) as usize && records.len() < (i32::MAX / 3) as usize);
+        // 32-bit lane offsets: half a billion vertices or 700 million
+        // triangles (tens of gigabytes of mesh before any setup).
+        assert!(
+            points.len() < (i32::MAX / 4) as usize && records.len() < (i32::MAX / 3) as usize,
+            "a mesh of {} vertices and {} triangles is beyond the 2D setup's 32-bit lane offsets",
+            points.len(),
+            records.len()
+        );
         LaneVertices {
             points: points.as_flattened(),
             records: records.as_flattened(),
