@@ -37,6 +37,10 @@ const SRGB_BUCKETS: usize = 4096;
 /// non-negative values.
 struct SrgbTable {
     buckets: [Bucket; SRGB_BUCKETS + 1],
+    /// The buckets' fields apart, as lanes gather them: `next`, and
+    /// `first` as a float.
+    nexts: [f32; SRGB_BUCKETS + 1],
+    firsts: [f32; SRGB_BUCKETS + 1],
     #[cfg(test)]
     thresholds: [f32; 257],
 }
@@ -82,6 +86,8 @@ fn srgb_table() -> &'static SrgbTable {
         }
         SrgbTable {
             buckets,
+            nexts: buckets.map(|b| b.next),
+            firsts: buckets.map(|b| f32::from(b.first)),
             #[cfg(test)]
             thresholds,
         }
@@ -135,27 +141,24 @@ pub fn encode_rgb(c: Vec3) -> [u8; 4] {
 }
 
 /// [`encode_rgb`] of eight colours in lanes, channel by channel (red,
-/// green, blue): the clamp and the bucket index in lanes (`v ≥ 1` → 1, then
-/// `v · 4096` truncated, a NaN or negative lane to bucket 0, as the scalar
-/// `as usize` gives), then per lane the bucket's byte.
+/// green, blue), all in lanes: the clamp and the bucket index (`v ≥ 1` → 1,
+/// then `v · 4096` truncated, a NaN or negative lane to bucket 0, as the
+/// scalar `as usize` gives), the bucket's first byte and next start
+/// gathered, and the byte `first + (v ≥ next)` (a NaN lane: not `≥`).
 #[inline(always)]
 pub(crate) fn encode_rgb_eight<L: Lanes>(channels: [L; 3]) -> [[u8; 4]; 8] {
     let table = srgb_table();
-    let one = L::splat(1.0);
-    let mut out = [[0, 0, 0, 255]; 8];
+    let (one, zero) = (L::splat(1.0), L::splat(0.0));
+    let mut bytes = [[0u32; 8]; 3];
     for (c, v) in channels.into_iter().enumerate() {
         let v = L::select(v.ge(one), one, v);
         // `maxps` gives its second operand, 0, for a NaN lane.
-        let at = (v * L::splat(SRGB_BUCKETS as f32))
-            .max(L::splat(0.0))
-            .truncate();
-        let v = v.to_array();
-        for l in 0..8 {
-            let bucket = &table.buckets[at[l] as usize];
-            out[l][c] = bucket.first + u8::from(v[l] >= bucket.next);
-        }
+        let at = (v * L::splat(SRGB_BUCKETS as f32)).max(zero).truncate();
+        let (next, first) = (L::gather(&table.nexts, at), L::gather(&table.firsts, at));
+        // Small whole numbers: exact, and truncated exactly.
+        bytes[c] = (first + L::select(v.ge(next), one, zero)).truncate();
     }
-    out
+    std::array::from_fn(|l| [bytes[0][l] as u8, bytes[1][l] as u8, bytes[2][l] as u8, 255])
 }
 
 #[cfg(test)]
