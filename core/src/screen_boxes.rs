@@ -23,7 +23,7 @@ use crate::edge::EPS;
 use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
-use crate::simd::{self, Lanes, abs, finite};
+use crate::simd::{self, Lanes, abs, finite, first_lanes};
 
 /// Non-planar viewports' screen box: the bounds of the triangle's cap of
 /// directions ([`crate::camera::SphereMap::bounds_of`]), padded by a pixel.
@@ -409,60 +409,14 @@ impl ScreenBoxes {
         map.image_box(p, &points, view)?.pixels(view, span)
     }
 
-    /// [`ScreenBoxes::rect`] of the first `n` of eight triangles, the same
-    /// boxes: where a triangle's three vertices are projected (the common
-    /// case), its box and pixels are computed eight triangles at a time
-    /// ([`pixels_eight`]); the others take [`ScreenBoxes::rect`]'s own path.
-    #[inline]
-    pub(crate) fn rects_eight(
-        &self,
-        corners: &[&[Vec3; 3]; 8],
-        vertices: &[[u32; 3]; 8],
-        n: usize,
-        view: &View,
-        span: SampleSpan,
-    ) -> [Option<PixelRect>; 8] {
-        let mut rects = [None; 8];
-        // 0 in lanes not computed here.
-        let mut points: LanePoints = [[[0.0; 8]; 3]; 3];
-        let mut projected = 0u8;
-        for l in 0..n.min(8) {
-            // Non-planar views project nothing (`points` is empty).
-            let mut all = self.map.is_some();
-            for (k, &v) in vertices[l].iter().enumerate() {
-                match self
-                    .points
-                    .get(v as usize)
-                    .map(|&p| ImagePoint::unpacked(p))
-                {
-                    Some(ImagePoint::Projected { x, y, pad }) => {
-                        [points[0][k][l], points[1][k][l], points[2][k][l]] = [x, y, pad];
-                    }
-                    _ => all = false,
-                }
-            }
-            if all {
-                projected |= 1 << l;
-            } else {
-                rects[l] = self.rect(corners[l], vertices[l], view, span);
-            }
-        }
-        if projected != 0 {
-            let computed = pixels_eight(&points, [view.width, view.height], span);
-            for (l, rect) in rects.iter_mut().enumerate() {
-                if projected >> l & 1 == 1 {
-                    *rect = computed[l];
-                }
-            }
-        }
-        rects
-    }
-
-    /// [`ScreenBoxes::rects_eight`] with the vertices in lanes: lane `l`'s
+    /// [`ScreenBoxes::rect`] of eight triangles, the same boxes: lane `l`'s
     /// triangle has mesh vertices `vertices[k][l]` (every lane's index a
-    /// vertex; lanes outside `present` get `None`). The projected points
-    /// are gathered into lanes; a lane with a vertex not projected takes
-    /// [`ScreenBoxes::rect`]'s own path (with its corners from `positions`).
+    /// vertex; lanes outside `present` get `None`). Where its three vertices
+    /// are projected (the common case), their points are gathered into
+    /// lanes and the box and pixels computed there ([`pixels_lanes`]); a
+    /// lane with a vertex not projected, and every lane of a non-planar
+    /// view, takes [`ScreenBoxes::rect`]'s own path (with its corners from
+    /// `positions`).
     #[inline(always)]
     pub(crate) fn rects_lanes<L: Lanes>(
         &self,
@@ -592,10 +546,6 @@ fn gathered_point<L: Lanes>(flat: &[f32], v: [u32; 8]) -> [L; 3] {
     ]
 }
 
-/// Eight triangles' projected vertices: x, y and rounding bound (as in
-/// [`ImagePoint::Projected`]), each per vertex and lane.
-type LanePoints = [[[f32; 8]; 3]; 3];
-
 simd::dispatch! {
     /// [`ImageMap::point`] of eight vertices `p − eye`, one per lane.
     fn points_eight<>(map: &ImageMap, p: [Vec3; 8], eye: Vec3) -> [ImagePoint; 8] => points_eight_on
@@ -676,49 +626,13 @@ fn max_f32<L: Lanes>(a: L, b: L) -> L {
     L::select(b.eq(b), a.max(b), a)
 }
 
-simd::dispatch! {
-    /// [`ImageBox::of`] and [`ImageBox::pixels`] for eight triangles, one per
-    /// lane: `points` holds per coordinate (x, y, rounding bound) and vertex
-    /// each lane's projected vertex. The same operations as the scalar ones,
-    /// so the same pixels: minima, maxima and the bound's maximum are exact
-    /// in any order on the finite values [`ImageMap::point`] projects, and
-    /// the lanes' `floor`/`ceil` are exact (`PixelRect::from_bounds`'s
-    /// differ from them only in the sign of a zero, which the pixel bounds
-    /// do not see).
-    fn pixels_eight<>(
-        points: &LanePoints,
-        size: [u32; 2],
-        span: SampleSpan,
-    ) -> [Option<PixelRect>; 8] => pixels_eight_on
-}
-
-#[inline(always)]
-fn pixels_eight_on<L: Lanes>(
-    [xs, ys, pads]: &LanePoints,
-    size: [u32; 2],
-    span: SampleSpan,
-) -> [Option<PixelRect>; 8] {
-    let points = [
-        [
-            L::from_array(xs[0]),
-            L::from_array(ys[0]),
-            L::from_array(pads[0]),
-        ],
-        [
-            L::from_array(xs[1]),
-            L::from_array(ys[1]),
-            L::from_array(pads[1]),
-        ],
-        [
-            L::from_array(xs[2]),
-            L::from_array(ys[2]),
-            L::from_array(pads[2]),
-        ],
-    ];
-    pixels_lanes(&points, size, span).options()
-}
-
-/// [`pixels_eight`] of points in lanes: per vertex, x, y and rounding bound.
+/// [`ImageBox::of`] and [`ImageBox::pixels`] for eight triangles, one per
+/// lane: `points` holds per vertex each lane's projected vertex (x, y,
+/// rounding bound). The same operations as the scalar ones, so the same
+/// pixels: minima, maxima and the bound's maximum are exact in any order on
+/// the finite values [`ImageMap::point`] projects, and the lanes'
+/// `floor`/`ceil` are exact (`PixelRect::from_bounds`'s differ from them only
+/// in the sign of a zero, which the pixel bounds do not see).
 #[inline(always)]
 pub(crate) fn pixels_lanes<L: Lanes>(
     points: &[[L; 3]; 3],
@@ -749,6 +663,33 @@ pub(crate) fn strided(index: [u32; 8], stride: u32, field: u32) -> [u32; 8] {
 #[inline(always)]
 fn dot_lanes<L: Lanes>(r: Vec3, v: &[L; 3]) -> L {
     (L::splat(r.x) * v[0] + L::splat(r.y) * v[1]) + L::splat(r.z) * v[2]
+}
+
+simd::dispatch! {
+    /// [`ScreenBoxes::rects_lanes`] of the first `n` (at least one) of eight
+    /// triangles with vertex records `vertices` (lanes past `n` repeat a
+    /// record of the mesh): the setups that read their triangles one by one.
+    pub(crate) fn rects_eight<>(
+        boxes: &ScreenBoxes,
+        vertices: &[[u32; 3]; 8],
+        n: usize,
+        positions: &[Vec3],
+        view: &View,
+        span: SampleSpan,
+    ) -> [Option<PixelRect>; 8] => rects_eight_on
+}
+
+#[inline(always)]
+fn rects_eight_on<L: Lanes>(
+    boxes: &ScreenBoxes,
+    vertices: &[[u32; 3]; 8],
+    n: usize,
+    positions: &[Vec3],
+    view: &View,
+    span: SampleSpan,
+) -> [Option<PixelRect>; 8] {
+    let lanes = std::array::from_fn(|k| vertices.map(|v| v[k]));
+    (boxes.rects_lanes::<L>(&lanes, first_lanes(n), positions, view, span)).options()
 }
 
 /// Grows eight boxes `[min_x, min_y, max_x, max_y]` by a point each;
@@ -1139,6 +1080,35 @@ mod tests {
         }
     }
 
+    /// Eight triangles' projected vertices: x, y and rounding bound (as in
+    /// [`ImagePoint::Projected`]), each per coordinate, vertex and lane.
+    type LanePoints = [[[f32; 8]; 3]; 3];
+
+    simd::dispatch! {
+        /// [`pixels_lanes`] of points given per coordinate, vertex and lane.
+        fn pixels_eight<>(
+            points: &LanePoints,
+            size: [u32; 2],
+            span: SampleSpan,
+        ) -> [Option<PixelRect>; 8] => pixels_eight_on
+    }
+
+    #[inline(always)]
+    fn pixels_eight_on<L: Lanes>(
+        [xs, ys, pads]: &LanePoints,
+        size: [u32; 2],
+        span: SampleSpan,
+    ) -> [Option<PixelRect>; 8] {
+        let lanes = |k: usize| {
+            [
+                L::from_array(xs[k]),
+                L::from_array(ys[k]),
+                L::from_array(pads[k]),
+            ]
+        };
+        pixels_lanes(&[lanes(0), lanes(1), lanes(2)], size, span).options()
+    }
+
     /// `pixels` (one of the lane forms of [`pixels_eight`]) gives, lane by
     /// lane, the pixels [`ImageBox::of`] and [`ImageBox::pixels`] give each
     /// lane's three points, for every sample span and image size, with
@@ -1337,8 +1307,8 @@ mod tests {
         assert!(fallback > 100, "{fallback} lanes took the scalar fallback");
     }
 
-    /// [`ScreenBoxes::rects_eight`] is [`ScreenBoxes::rect`] per triangle, on
-    /// every viewport, for groups of one to eight triangles that reach
+    /// [`rects_eight`] (so [`ScreenBoxes::rects_lanes`]) is
+    /// [`ScreenBoxes::rect`] per triangle, on every viewport, for groups of one to eight triangles that reach
     /// nearer than `near` (the clipped path), behind the eye or not at all.
     #[test]
     fn rects_of_eight_triangles_are_their_rects() {
@@ -1370,13 +1340,13 @@ mod tests {
                 .map(|t| [t[0], t[1], t[2]])
                 .collect();
             let n = rng.usize(1..=8);
-            let corners = std::array::from_fn(|l| &triangles[l.min(n - 1)]);
+            let corners: [&[Vec3; 3]; 8] = std::array::from_fn(|l| &triangles[l.min(n - 1)]);
             let vertices = std::array::from_fn(|l| {
                 let k = 3 * l.min(n - 1) as u32;
                 [k, k + 1, k + 2]
             });
             let span = SamplePattern::of(AaMode::None).span;
-            let rects = screen.rects_eight(&corners, &vertices, n, &view, span);
+            let rects = rects_eight(&screen, &vertices, n, &positions, &view, span);
             for l in 0..8 {
                 let single = (l < n)
                     .then(|| screen.rect(corners[l], vertices[l], &view, span))

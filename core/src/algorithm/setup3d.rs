@@ -13,7 +13,7 @@ use crate::edge::{
 use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
-use crate::screen_boxes::{PixelRects, ScreenBoxes, strided};
+use crate::screen_boxes::{PixelRects, ScreenBoxes, rects_eight, strided};
 use crate::simd::{self, Lanes, first_lanes};
 
 /// Every drawable triangle with samples on screen, set up with 3D edge functions.
@@ -29,20 +29,7 @@ pub(crate) fn setup_3d<'a>(
     }
     let boxes = ScreenBoxes::new(scene, view);
     let lanes = LaneMesh::new(&boxes, &mesh.positions, &mesh.triangles, view, span);
-    let eights = scene.drawable.par_chunks(8).map(|ids| {
-        // Eight ids are read in one load from where they lie (an array
-        // built lane by lane would be read back before its stores land); a
-        // last, shorter chunk repeats its last id.
-        let (rects, triangles) = match ids.try_into() {
-            Ok(eight) => setup_3d_eight(&lanes, Records::Listed(eight), 8),
-            Err(_) => {
-                let padded = lanes_of(ids).map(|&id| id);
-                setup_3d_eight(&lanes, Records::Listed(&padded), ids.len())
-            }
-        };
-        paired(|l| rects.get(l), lanes_of(ids), triangles)
-    });
-    flattened(eights.unzip(), scene.drawable.len(), shared)
+    set_up_in_lanes(&lanes, &scene.drawable, false, shared)
 }
 
 /// [`setup_slots`] of [`Triangle3D`]s: every BVH slot's triangle set up
@@ -60,13 +47,33 @@ pub(crate) fn setup_slots_3d<'a>(
     }
     let boxes = ScreenBoxes::new(scene, view);
     let lanes = LaneMesh::new(&boxes, positions, &scene.slot_vertices, view, span);
-    let chunks = scene.slot_triangles.par_chunks(8).enumerate();
-    let eights = chunks.map(|(chunk, ids)| {
-        let records = Records::Run((chunk * 8) as u32);
-        let (rects, triangles) = setup_3d_eight(&lanes, records, ids.len());
-        paired(|l| rects.get(l), lanes_of(ids), triangles)
+    set_up_in_lanes(&lanes, &scene.slot_triangles, true, shared)
+}
+
+/// The triangles `ids` set up in lanes ([`setup_3d_eight`]), eight at a
+/// time: `mesh`'s records by id, or (`by_slot`) the records in a row, one
+/// per item (the BVH's slots, whose triangles `ids` lists).
+fn set_up_in_lanes<'a>(
+    mesh: &LaneMesh,
+    ids: &[u32],
+    by_slot: bool,
+    shared: Shared3D<'a>,
+) -> Setups<'a, Triangle3D> {
+    let eights = ids.par_chunks(8).enumerate().map(|(chunk, eight)| {
+        // Eight ids are read in one load from where they lie (an array
+        // built lane by lane would be read back before its stores land); a
+        // last, shorter chunk repeats its last id.
+        let (rects, triangles) = match (by_slot, eight.try_into()) {
+            (true, _) => setup_3d_eight(mesh, Records::Run((chunk * 8) as u32), eight.len()),
+            (false, Ok(listed)) => setup_3d_eight(mesh, Records::Listed(listed), 8),
+            (false, Err(_)) => {
+                let padded = lanes_of(eight).map(|&id| id);
+                setup_3d_eight(mesh, Records::Listed(&padded), eight.len())
+            }
+        };
+        paired(|l| rects.get(l), lanes_of(eight), triangles)
     });
-    flattened(eights.unzip(), scene.slot_triangles.len(), shared)
+    flattened(eights.unzip(), ids.len(), shared)
 }
 
 /// What a perspective setup in lanes ([`setup_3d_eight`]) reads: the mesh's
@@ -265,6 +272,7 @@ pub(crate) fn setup_slots<'a, T: Stored>(
     setup: impl SetupEight<'a, T>,
 ) -> Setups<'a, T> {
     let boxes = ScreenBoxes::new(scene, view);
+    let positions = &scene.scene.mesh.positions;
     let chunks = (scene.slot_corners.par_chunks(8))
         .zip(scene.slot_vertices.par_chunks(8))
         .zip(scene.slot_triangles.par_chunks(8));
@@ -274,7 +282,7 @@ pub(crate) fn setup_slots<'a, T: Stored>(
             vertices: lanes_of(vertices).map(|v| *v),
             present: 0,
         };
-        let rects = rects_of(&boxes, &mut eight, p.len(), view, span);
+        let rects = rects_of(&boxes, &mut eight, p.len(), positions, view, span);
         paired(|l| rects[l], lanes_of(ids), setup(&eight, view))
     });
     flattened(eights.unzip(), scene.slot_triangles.len(), shared)
@@ -320,17 +328,19 @@ fn lanes_of<T>(v: &[T]) -> [&T; 8] {
     std::array::from_fn(|l| &v[l.min(v.len() - 1)])
 }
 
-/// The screen boxes of the first `n` of `eight`'s triangles, whose
-/// `present` mask becomes the lanes that have one (the lanes to set up).
+/// The screen boxes of the first `n` of `eight`'s triangles (vertices of
+/// the mesh with `positions`), whose `present` mask becomes the lanes that
+/// have one (the lanes to set up).
 #[inline]
 fn rects_of(
     boxes: &ScreenBoxes,
     eight: &mut EightTriangles,
     n: usize,
+    positions: &[Vec3],
     view: &View,
     span: SampleSpan,
 ) -> [Option<PixelRect>; 8] {
-    let rects = boxes.rects_eight(&eight.corners, &eight.vertices, n, view, span);
+    let rects = rects_eight(boxes, &eight.vertices, n, positions, view, span);
     eight.present = 0;
     for (l, rect) in rects.iter().enumerate() {
         eight.present |= u8::from(rect.is_some()) << l;
@@ -350,7 +360,7 @@ fn setup_visible<'a, T: Stored>(
     setup: impl SetupEight<'a, T>,
 ) -> Setups<'a, T> {
     let boxes = ScreenBoxes::new(scene, view);
-    let corners = &scene.scene.mesh.triangles;
+    let (positions, corners) = (&scene.scene.mesh.positions, &scene.scene.mesh.triangles);
     let eights = (scene.drawable.par_chunks(8).enumerate()).map(|(chunk, ids)| {
         // The slot-ordered corners are scattered in id order: the next
         // eight triangles' are on their way while these are set up.
@@ -366,7 +376,7 @@ fn setup_visible<'a, T: Stored>(
             vertices: id.map(|id| corners[id]),
             present: 0,
         };
-        let rects = rects_of(&boxes, &mut eight, ids.len(), view, span);
+        let rects = rects_of(&boxes, &mut eight, ids.len(), positions, view, span);
         paired(|l| rects[l], lanes_of(ids), setup(&eight, view))
     });
     flattened(eights.unzip(), scene.drawable.len(), shared)
@@ -380,11 +390,12 @@ mod tests {
 
     type Kernel = fn(&LaneMesh, Records, usize) -> (PixelRects, [Option<Triangle3D>; 8]);
 
-    /// `kernel` gives every lane the box and the set-up triangle that the
-    /// eight-at-a-time path gives ([`rects_of`], [`Triangle3D::setup_eight`],
-    /// each checked against the one-triangle forms), bit for bit: random
-    /// meshes of shared vertices on screen, off it, across the near plane
-    /// and behind the eye; listed and run records; full and short chunks.
+    /// `kernel` gives every lane the box [`ScreenBoxes::rect`] gives and the
+    /// set-up triangle the eight-at-a-time path gives
+    /// ([`Triangle3D::setup_eight`], checked against the one-triangle form),
+    /// bit for bit: random meshes of shared vertices on screen, off it,
+    /// across the near plane and behind the eye; listed and run records;
+    /// full and short chunks.
     fn lanes_match_the_eight_path(kernel: Kernel) {
         let mut rng = fastrand::Rng::with_seed(31);
         let (mut checked, mut set_up, mut scalar_boxes) = (0, 0, 0);
@@ -429,12 +440,17 @@ mod tests {
                 let (rects, triangles) = kernel(&mesh, records_of, n);
                 let corners: [[Vec3; 3]; 8] =
                     items.map(|i| records[i as usize].map(|v| positions[v as usize]));
-                let mut eight = EightTriangles {
+                let vertices = items.map(|i| records[i as usize]);
+                let expected_rects: [_; 8] = std::array::from_fn(|l| {
+                    (l < n)
+                        .then(|| boxes.rect(&corners[l], vertices[l], &view, span))
+                        .flatten()
+                });
+                let eight = EightTriangles {
                     corners: std::array::from_fn(|l| &corners[l]),
-                    vertices: items.map(|i| records[i as usize]),
-                    present: 0,
+                    vertices,
+                    present: (0..8).fold(0, |m, l| m | u8::from(expected_rects[l].is_some()) << l),
                 };
-                let expected_rects = rects_of(&boxes, &mut eight, n, &view, span);
                 let expected = Triangle3D::setup_eight(&eight, &view);
                 for l in 0..8 {
                     let at = format!("case {case}, lane {l} of {n}");
@@ -448,7 +464,7 @@ mod tests {
                     checked += usize::from(l < n);
                     set_up += usize::from(l < n && triangles[l].is_some());
                     let projected =
-                        (0..3).all(|k| boxes.points[eight.vertices[l][k] as usize][0].is_finite());
+                        (0..3).all(|k| boxes.points[vertices[l][k] as usize][0].is_finite());
                     scalar_boxes += usize::from(l < n && !projected);
                 }
             }
