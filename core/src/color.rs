@@ -144,21 +144,26 @@ pub fn encode_rgb(c: Vec3) -> [u8; 4] {
 /// green, blue), all in lanes: the clamp and the bucket index (`v ≥ 1` → 1,
 /// then `v · 4096` truncated, a NaN or negative lane to bucket 0, as the
 /// scalar `as usize` gives), the bucket's first byte and next start
-/// gathered, and the byte `first + (v ≥ next)` (a NaN lane: not `≥`).
+/// gathered, and the byte `first + (v ≥ next)` (a NaN lane: not `≥`). The
+/// three bytes are packed into one word per lane in lanes too (`r + 2⁸g +
+/// 2¹⁶b` is below 2²⁴: exact in f32), so the pixels leave in one store (a
+/// pixel built byte by byte and then copied whole waits for its stores).
 #[inline(always)]
 pub(crate) fn encode_rgb_eight<L: Lanes>(channels: [L; 3]) -> [[u8; 4]; 8] {
     let table = srgb_table();
     let (one, zero) = (L::splat(1.0), L::splat(0.0));
-    let mut bytes = [[0u32; 8]; 3];
-    for (c, v) in channels.into_iter().enumerate() {
+    let mut packed = zero;
+    for (v, weight) in channels.into_iter().zip([1.0, 256.0, 65536.0]) {
         let v = L::select(v.ge(one), one, v);
         // `maxps` gives its second operand, 0, for a NaN lane.
         let at = (v * L::splat(SRGB_BUCKETS as f32)).max(zero).truncate();
         let (next, first) = (L::gather(&table.nexts, at), L::gather(&table.firsts, at));
-        // Small whole numbers: exact, and truncated exactly.
-        bytes[c] = (first + L::select(v.ge(next), one, zero)).truncate();
+        // Small whole numbers, and their weighted sum: exact.
+        packed = packed + (first + L::select(v.ge(next), one, zero)) * L::splat(weight);
     }
-    std::array::from_fn(|l| [bytes[0][l] as u8, bytes[1][l] as u8, bytes[2][l] as u8, 255])
+    // Byte order in memory: red first, alpha last.
+    let words = packed.truncate().map(|rgb| (rgb | 0xff00_0000).to_le());
+    bytemuck::cast(words)
 }
 
 #[cfg(test)]
