@@ -76,8 +76,6 @@ mod sealed {
         fn eq(self, o: Self) -> u8;
         /// Lane `l` of `a` where bit `l` of `mask` is set, of `b` elsewhere.
         fn select(mask: u8, a: Self, b: Self) -> Self;
-        /// Lane `l` is lane `from[l]` (below 8) of `self`.
-        fn permute(self, from: [u32; 8]) -> Self;
         /// Each lane truncated toward zero, as `f32 as u32` (for lanes in
         /// `[0, 2³¹)`: the only ones callers pass).
         fn truncate(self) -> [u32; 8];
@@ -151,15 +149,6 @@ impl sealed::Ops for Portable {
             }
         }
         Self::from_array(b)
-    }
-    #[inline(always)]
-    fn permute(self, from: [u32; 8]) -> Self {
-        let v = self.to_array();
-        let mut out = [0.0; 8];
-        for (o, &f) in out.iter_mut().zip(&from) {
-            *o = v[f as usize & 7];
-        }
-        Self::from_array(out)
     }
     #[inline(always)]
     fn truncate(self) -> [u32; 8] {
@@ -296,12 +285,6 @@ mod avx2_lanes {
                 let lanes = _mm256_castsi256_ps(_mm256_cmpeq_epi32(set, bits));
                 Avx2(_mm256_blendv_ps(b.0, a.0, lanes))
             })
-        }
-        #[inline(always)]
-        fn permute(self, from: [u32; 8]) -> Self {
-            // SAFETY: `[u32; 8]` and `__m256i` are both 32 bytes.
-            let from = unsafe { std::mem::transmute::<[u32; 8], __m256i>(from) };
-            Avx2(avx!(_mm256_permutevar8x32_ps(self.0, from)))
         }
         #[inline(always)]
         fn truncate(self) -> [u32; 8] {

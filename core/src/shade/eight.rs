@@ -12,7 +12,7 @@
 //! normal or light vector that does not normalize, a NaN) are not shaded
 //! here: the caller shades them with [`Shader::shade`].
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 use super::{AMBIENT, LightFrom, Shader};
 use crate::simd::{Lanes, finite};
@@ -35,13 +35,13 @@ impl<L: Lanes> V3<L> {
         }
     }
 
-    /// Eight vectors given axis by axis, lane `l` taken from column `from[l]`.
+    /// `v` in the lanes of `lanes`, `self` in the others.
     #[inline(always)]
-    fn of([x, y, z]: &[[f32; 8]; 3], from: [u32; 8]) -> Self {
+    fn blend(self, lanes: u8, v: Vec3) -> Self {
         V3 {
-            x: L::from_array(*x).permute(from),
-            y: L::from_array(*y).permute(from),
-            z: L::from_array(*z).permute(from),
+            x: L::select(lanes, L::splat(v.x), self.x),
+            y: L::select(lanes, L::splat(v.y), self.y),
+            z: L::select(lanes, L::splat(v.z), self.z),
         }
     }
 
@@ -168,66 +168,65 @@ impl Shader<'_> {
         // 1. What each lane's triangle brings (lanes without one take the
         // first that has one, so that every lane computes on real values).
         // Neighbouring samples mostly hold one triangle: each run of lanes
-        // holding one has its records read once, into column `d` of
-        // `records` (per vertex `k` and axis `a`: corner `[k][a]`, vertex
-        // normal `[3 + k][a]`; base colour `[6]`, emission `[7]`), and lane
-        // `l` takes column `run[l]` by a lane permute.
+        // holding one has its records read once, and broadcast into its
+        // lanes (not stored lane by lane and read back whole, which waits
+        // for the stores to land).
         let first = s.ids[done.trailing_zeros() as usize];
-        let mut records = [[[0.0f32; 8]; 3]; 8];
-        let mut run = [0u32; 8];
-        // The last run's triangle and whether one of its vertex normals is
-        // zero (the scalar path's case: its lanes go there).
-        let mut last: Option<(u32, bool)> = None;
-        let mut runs = 0;
-        for (l, lane_run) in run.iter_mut().enumerate() {
-            let id = if done & (1 << l) != 0 {
-                s.ids[l]
-            } else {
-                first
-            };
-            if let Some((_, zero_normal)) = last.filter(|&(previous, _)| previous == id) {
-                *lane_run = runs - 1;
-                if zero_normal {
-                    done &= !(1 << l);
-                }
-                continue;
+        let mut ids = [first; 8];
+        let mut starts = 1u8;
+        for l in 0..8 {
+            if done & (1 << l) != 0 {
+                ids[l] = s.ids[l];
             }
-            let d = runs as usize;
+            if l > 0 && ids[l] != ids[l - 1] {
+                starts |= 1 << l;
+            }
+        }
+        let zero = V3::splat(Vec3::ZERO);
+        let (mut p, mut normals) = ([zero; 3], [zero; 3]);
+        let materials = &prepared.scene.materials;
+        let one_material = materials.len() == 1;
+        let (mut base, mut emissive) = match one_material {
+            true => (
+                V3::splat(Vec4::from(materials[0].base_color).truncate()),
+                V3::splat(Vec3::from(materials[0].emissive)),
+            ),
+            false => (zero, zero),
+        };
+        let mut rest = starts;
+        while rest != 0 {
+            let l = rest.trailing_zeros();
+            rest &= rest - 1;
+            let end = if rest == 0 { 8 } else { rest.trailing_zeros() };
+            let lanes = ((1u16 << end) - (1u16 << l)) as u8;
+            let id = ids[l as usize];
             // From the mesh: two dependent reads (vertex indices, then
             // positions and normals side by side), where the slot-ordered
             // copies take three (slot, copies, normals): a 1080p frame of
             // teapots or the dragon 1–3 ms shorter.
             let vertices = mesh.triangles[id as usize];
-            let p = vertices.map(|v| mesh.positions[v as usize]);
-            let material = &prepared.scene.materials[self.material_of(id) as usize];
-            for a in 0..3 {
-                for k in 0..3 {
-                    records[k][a][d] = p[k][a];
-                }
-                records[6][a][d] = material.base_color[a];
-                records[7][a][d] = material.emissive[a];
+            for k in 0..3 {
+                p[k] = p[k].blend(lanes, mesh.positions[vertices[k] as usize]);
             }
-            let mut zero_normal = false;
+            if !one_material {
+                let material = &materials[self.material_of(id) as usize];
+                base = base.blend(lanes, Vec4::from(material.base_color).truncate());
+                emissive = emissive.blend(lanes, Vec3::from(material.emissive));
+            }
             if interpolated {
-                for (k, &v) in vertices.iter().enumerate() {
-                    let n = mesh.normals[v as usize];
+                let mut zero_normal = false;
+                for k in 0..3 {
+                    let n = mesh.normals[vertices[k] as usize];
                     zero_normal |= n == Vec3::ZERO;
-                    for a in 0..3 {
-                        records[3 + k][a][d] = n[a];
-                    }
+                    normals[k] = normals[k].blend(lanes, n);
                 }
+                // The scalar path's case: these lanes go there.
                 if zero_normal {
-                    done &= !(1 << l);
+                    done &= !lanes;
                 }
             }
-            (*lane_run, runs) = (runs, runs + 1);
-            last = Some((id, zero_normal));
         }
-        let [p0, p1, p2] = [
-            V3::<L>::of(&records[0], run),
-            V3::<L>::of(&records[1], run),
-            V3::<L>::of(&records[2], run),
-        ];
+        let [p0, p1, p2] = p;
 
         // 2. The ray through each sample (`View::origin`, `View::direction`).
         let view = self.view;
@@ -257,9 +256,9 @@ impl Shader<'_> {
             let v2 = q[0].cross(q[1]).dot(dir);
             let total = v0 + v1 + v2;
             done &= !total.eq(L::splat(0.0)) & finite(total);
-            let n0 = V3::<L>::of(&records[3], run).scale(v0 / total);
-            let n1 = V3::<L>::of(&records[4], run).scale(v1 / total);
-            let n2 = V3::<L>::of(&records[5], run).scale(v2 / total);
+            let n0 = normals[0].scale(v0 / total);
+            let n1 = normals[1].scale(v1 / total);
+            let n2 = normals[2].scale(v2 / total);
             let n = n0.add(n1).add(n2);
             let (n, ok) = n.normalized();
             done &= ok;
@@ -292,7 +291,6 @@ impl Shader<'_> {
             done &= lambert.eq(lambert);
             lit = lit.add(V3::splat(color).scale(lambert.max(zero)));
         }
-        let (base, emissive) = (V3::<L>::of(&records[6], run), V3::<L>::of(&records[7], run));
         let r = base.x * ambient(lit.x) + emissive.x;
         let g = base.y * ambient(lit.y) + emissive.y;
         let b = base.z * ambient(lit.z) + emissive.z;
