@@ -379,6 +379,33 @@ pub(crate) fn first_lanes(n: usize) -> u8 {
     ((1u16 << n.min(8)) - 1) as u8
 }
 
+/// A chunk of one to eight ids as eight lanes' worth: the chunk itself
+/// when it is full (read in one load from where it lies: an array built
+/// lane by lane would be read back before its stores land), else a copy
+/// whose lanes past its end repeat its last id.
+pub(crate) enum EightIds<'a> {
+    Full(&'a [u32; 8]),
+    Padded([u32; 8]),
+}
+
+impl<'a> EightIds<'a> {
+    #[inline(always)]
+    pub(crate) fn of(ids: &'a [u32]) -> EightIds<'a> {
+        match ids.try_into() {
+            Ok(full) => EightIds::Full(full),
+            Err(_) => EightIds::Padded(std::array::from_fn(|l| ids[l.min(ids.len() - 1)])),
+        }
+    }
+
+    #[inline(always)]
+    pub(crate) fn get(&self) -> &[u32; 8] {
+        match self {
+            EightIds::Full(ids) => ids,
+            EightIds::Padded(ids) => ids,
+        }
+    }
+}
+
 /// Defines `fn NAME<G: Bound, ..>(args) -> R` (or `fn NAME<G: Bound, ..; const
 /// C: Type, ..>`: const parameters after a semicolon) that runs
 /// `BODY::<L, G, .., C, ..>(args)`

@@ -17,7 +17,7 @@ use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
 use crate::screen_boxes::{PixelRects, pixels_lanes, strided};
-use crate::simd::{self, Lanes, finite, first_lanes};
+use crate::simd::{self, EightIds, Lanes, finite, first_lanes};
 
 /// Every drawable triangle, clipped, projected and set up with f32 edge
 /// functions; pieces without samples on screen are dropped.
@@ -122,15 +122,7 @@ fn setup_pieces<T: Projected>(
     let (first, more): (Columns<T>, Vec<u8>) = (scene.drawable.par_chunks(8))
         .map(|ids| {
             // The lanes whose three vertices are all kept, set up together.
-            // Eight ids are read in one load from where they lie; a last,
-            // shorter chunk repeats its last id.
-            let eight = match ids.try_into() {
-                Ok(eight) => kept_eight(&lanes, eight, 8),
-                Err(_) => {
-                    let padded = std::array::from_fn(|l| ids[l.min(ids.len() - 1)]);
-                    kept_eight(&lanes, &padded, ids.len())
-                }
-            };
+            let eight = kept_eight(&lanes, EightIds::of(ids).get(), ids.len());
             let unclipped = eight.kept;
             // Set up in place: each lane's triangle stays where it is made.
             let mut triangles = [const { None }; 8];

@@ -14,7 +14,7 @@ use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
 use crate::screen_boxes::{PixelRects, ScreenBoxes, rects_eight, strided};
-use crate::simd::{self, Lanes, first_lanes};
+use crate::simd::{self, EightIds, Lanes, first_lanes};
 
 /// Every drawable triangle with samples on screen, set up with 3D edge functions.
 pub(crate) fn setup_3d<'a>(
@@ -60,15 +60,11 @@ fn set_up_in_lanes<'a>(
     shared: Shared3D<'a>,
 ) -> Setups<'a, Triangle3D> {
     let eights = ids.par_chunks(8).enumerate().map(|(chunk, eight)| {
-        // Eight ids are read in one load from where they lie (an array
-        // built lane by lane would be read back before its stores land); a
-        // last, shorter chunk repeats its last id.
-        let (rects, triangles) = match (by_slot, eight.try_into()) {
-            (true, _) => setup_3d_eight(mesh, Records::Run((chunk * 8) as u32), eight.len()),
-            (false, Ok(listed)) => setup_3d_eight(mesh, Records::Listed(listed), 8),
-            (false, Err(_)) => {
-                let padded = lanes_of(eight).map(|&id| id);
-                setup_3d_eight(mesh, Records::Listed(&padded), eight.len())
+        let (rects, triangles) = match by_slot {
+            true => setup_3d_eight(mesh, Records::Run((chunk * 8) as u32), eight.len()),
+            false => {
+                let listed = EightIds::of(eight);
+                setup_3d_eight(mesh, Records::Listed(listed.get()), eight.len())
             }
         };
         paired(|l| rects.get(l), lanes_of(eight), triangles)
@@ -81,7 +77,6 @@ fn set_up_in_lanes<'a>(
 /// the lanes gather from, the vertices' projections, the view.
 struct LaneMesh<'a> {
     positions: &'a [Vec3],
-    flat_positions: &'a [f32],
     records: &'a [u32],
     boxes: &'a ScreenBoxes,
     view: &'a View,
@@ -109,7 +104,6 @@ impl<'a> LaneMesh<'a> {
         debug_assert!(LaneMesh::applies(view, positions, records));
         LaneMesh {
             positions,
-            flat_positions: bytemuck::cast_slice(positions),
             records: records.as_flattened(),
             boxes,
             view,
@@ -129,10 +123,10 @@ enum Records<'a> {
 
 simd::dispatch! {
     /// The screen boxes and 3D setups of the first `n` (at least one) of
-    /// eight triangles with vertex records `records`, each exactly as [`rects_of`] and
-    /// [`Triangle3D::setup_eight`] make them: vertex indices, projected
-    /// points and corners gathered straight into lanes, with no per-lane
-    /// copies between the steps.
+    /// eight triangles with vertex records `records`, each exactly as
+    /// [`ScreenBoxes::rect`] and [`Triangle3D::setup_eight`] make them:
+    /// vertex indices, projected points and corners gathered straight into
+    /// lanes, with no per-lane copies between the steps.
     fn setup_3d_eight<>(
         mesh: &LaneMesh,
         records: Records,
@@ -165,10 +159,11 @@ fn setup_3d_eight_on<L: Lanes>(
     if present == 0 {
         return (rects, [None; 8]);
     }
+    let flat = bytemuck::cast_slice(mesh.positions);
     let corners = [
-        corner_lanes::<L>(mesh.flat_positions, vertices[0]),
-        corner_lanes::<L>(mesh.flat_positions, vertices[1]),
-        corner_lanes::<L>(mesh.flat_positions, vertices[2]),
+        corner_lanes::<L>(flat, vertices[0]),
+        corner_lanes::<L>(flat, vertices[1]),
+        corner_lanes::<L>(flat, vertices[2]),
     ];
     let corners_of = |l: usize| vertices.map(|v| mesh.positions[v[l] as usize]);
     (
