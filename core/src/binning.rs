@@ -12,7 +12,7 @@
 //! do: the same sample points through the same [`Coverage`] decision, so the
 //! same image bit for bit; the counters record the tests actually made.
 
-use crate::edge::{BlockTest, Coverage};
+use crate::edge::{BlockTest, Coverage, RowLanes};
 use crate::framebuffer::{SCRATCH_PIXELS, TileBuffer};
 use crate::ground::PixelRect;
 use crate::pipeline::SampleOracles;
@@ -133,25 +133,35 @@ fn sample_rows<L: Lanes, T: Coverage>(
     // incrementally, §3.5 eq. 3).
     let mut covered = 0;
     let n = r.width();
-    for y in r.y0..r.y1 {
-        let i = tile.index(r.x0, y);
-        for count in &mut tile.edge_evals[i..i + n as usize] {
-            *count += 1;
-        }
-        let (x0, y) = (r.x0 as f32 + 0.5, y as f32 + 0.5);
-        // Runs shorter than a group (small triangles) are written sample by
-        // sample: cheaper there than a group's loads and blends.
-        if T::OWN_SAMPLE_RUN || n < 8 {
-            tri.sample_run::<L>(x0, y, n, |k, w| {
+    let x0 = r.x0 as f32 + 0.5;
+    // Runs shorter than a group (small triangles) are written sample by
+    // sample: cheaper there than a group's loads and blends.
+    if T::OWN_SAMPLE_RUN || n < 8 {
+        for y in r.y0..r.y1 {
+            let i = tile.index(r.x0, y);
+            count_tests(tile, i, n);
+            tri.sample_run::<L>(x0, y as f32 + 0.5, n, |k, w| {
                 covered += 1;
                 tile.write(i + k as usize, w, id);
             });
-            continue;
         }
-        // Eight samples at a time, written (depth-tested) eight at a time.
+        return covered;
+    }
+    // Eight samples at a time, written (depth-tested) eight at a time, the
+    // triangle's lanes set out once. The points `x0 + k` are integers and a
+    // half, exact in f32, so stepping the lanes by eight forms each group's
+    // points as `sample8` would.
+    let mut rows = tri.rows::<L>();
+    let first = L::from_array([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]) + L::splat(x0);
+    for y in r.y0..r.y1 {
+        let i = tile.index(r.x0, y);
+        count_tests(tile, i, n);
+        rows.set_row(y as f32 + 0.5);
+        let mut x = first;
         for k in (0..n).step_by(8) {
             let active = first_lanes((n - k) as usize);
-            let (mask, w) = tri.sample8::<L>(x0 + k as f32, y, active);
+            let (mask, w) = rows.sample8(x0 + k as f32, x, active);
+            x = x + L::splat(8.0);
             if mask != 0 {
                 covered += mask.count_ones();
                 tile.write_eight::<L>(i + k as usize, mask, &w, id);
@@ -159,6 +169,14 @@ fn sample_rows<L: Lanes, T: Coverage>(
         }
     }
     covered
+}
+
+/// Counts a test at each of the `n` pixels from index `i`.
+#[inline(always)]
+fn count_tests(tile: &mut TileBuffer, i: usize, n: u32) {
+    for count in &mut tile.edge_evals[i..i + n as usize] {
+        *count += 1;
+    }
 }
 
 /// The small-triangle path: every sample of `r` (at most [`SMALL`], every

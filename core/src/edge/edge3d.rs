@@ -28,7 +28,7 @@ use std::num::NonZeroU32;
 use glam::{DVec3, Vec3};
 
 use super::exact::{self, Expansion};
-use super::{BlockTest, Coverage};
+use super::{BlockTest, Coverage, RowLanes};
 use crate::camera::View;
 use crate::simd::Lanes;
 
@@ -774,12 +774,39 @@ impl Bound3D<'_> {
     #[inline(always)]
     fn edges_lanes<L: Lanes>(&self, x: L, y: L, active: u8) -> u8 {
         let t = self.t;
+        let mut e = [L::splat(0.0); 3];
+        for k in 0..3 {
+            e[k] = Self::linear_lanes([t.a[k], t.b[k], t.c[k]], x, y);
+        }
+        self.inside_lanes(e, self.tolerance_lanes(), active, x, y)
+    }
+
+    /// Per edge, its tolerance and the tolerance's negation, in lanes.
+    #[inline(always)]
+    fn tolerance_lanes<L: Lanes>(&self) -> [[L; 2]; 3] {
+        let mut lanes = [[L::splat(0.0); 2]; 3];
+        for (k, pair) in lanes.iter_mut().enumerate() {
+            let tolerance = self.t.tolerance.get(k);
+            *pair = [L::splat(tolerance), L::splat(-tolerance)];
+        }
+        lanes
+    }
+
+    /// [`Bound3D::edges_lanes`] on the edge values `e` at `(x, y)`, with the
+    /// edges' [`Bound3D::tolerance_lanes`].
+    #[inline(always)]
+    fn inside_lanes<L: Lanes>(
+        &self,
+        e: [L; 3],
+        tolerance: [[L; 2]; 3],
+        active: u8,
+        x: L,
+        y: L,
+    ) -> u8 {
         let (mut certain_in, mut certain_out) = (active, !active);
         for k in 0..3 {
-            let e = Self::linear_lanes([t.a[k], t.b[k], t.c[k]], x, y);
-            let tolerance = t.tolerance.get(k);
-            certain_in &= e.gt(L::splat(tolerance));
-            certain_out |= e.lt(L::splat(-tolerance));
+            certain_in &= e[k].gt(tolerance[k][0]);
+            certain_out |= e[k].lt(tolerance[k][1]);
         }
         let undecided = !(certain_in | certain_out);
         if undecided == 0 {
@@ -807,10 +834,75 @@ impl Bound3D<'_> {
     /// `w` per lane, and `mask` narrowed to the lanes at or beyond `near`.
     #[inline(always)]
     fn depth_lanes<L: Lanes>(&self, facing: L, volume: L, mask: u8) -> (u8, [f32; 8]) {
+        depth_in(facing, volume, mask, self.depth_limits())
+    }
+
+    /// `w_min`, `w_max` and `near` in lanes.
+    #[inline(always)]
+    fn depth_limits<L: Lanes>(&self) -> [L; 3] {
         let [w_min, w_max] = self.t.w_range;
-        let w = (volume / facing).max(L::splat(w_min)).min(L::splat(w_max));
-        let mask = mask & w.ge(L::splat(self.shared.near));
-        (mask, w.to_array())
+        [L::splat(w_min), L::splat(w_max), L::splat(self.shared.near)]
+    }
+}
+
+/// `w = volume / facing` per lane clamped to `w_min..w_max`, and `mask`
+/// narrowed to the lanes at or beyond `near` (`limits`, in that order).
+#[inline(always)]
+fn depth_in<L: Lanes>(facing: L, volume: L, mask: u8, limits: [L; 3]) -> (u8, [f32; 8]) {
+    let [w_min, w_max, near] = limits;
+    let w = (volume / facing).max(w_min).min(w_max);
+    (mask & w.ge(near), w.to_array())
+}
+
+/// A [`Bound3D`] along rows ([`RowLanes`]): its coefficients splatted into
+/// lanes once, and per row the `y·C` terms, so that a group's values are
+/// `(A + x·B) + y·C` in [`Bound3D::linear_lanes`]'s order with no per-group
+/// loads or decoding.
+pub(crate) struct Rows3D<'a, L> {
+    tri: &'a Bound3D<'a>,
+    /// Per edge: `A`, `B`, and `C` splatted; then the row's `y·C`.
+    edges: [[L; 3]; 3],
+    edge_y: [L; 3],
+    tolerance: [[L; 2]; 3],
+    /// The varying part of depth: `k0`, `k1`, `k2` splatted; then the
+    /// row's `y·k2`.
+    varying: [L; 3],
+    varying_y: L,
+    constant: L,
+    limits: [L; 3],
+    y: L,
+}
+
+impl<L: Lanes> RowLanes<L> for Rows3D<'_, L> {
+    #[inline(always)]
+    fn set_row(&mut self, y: f32) {
+        self.y = L::splat(y);
+        for k in 0..3 {
+            self.edge_y[k] = self.y * self.edges[k][2];
+        }
+        self.varying_y = self.y * self.varying[2];
+    }
+
+    /// [`Bound3D::sample_lanes`] with the row's terms.
+    #[inline(always)]
+    fn sample8(&self, _: f32, x: L, active: u8) -> (u8, [f32; 8]) {
+        let [k0, k1, _] = self.varying;
+        let varying = k0 + x * k1 + self.varying_y;
+        let (facing, volume) = if self.tri.shared.parallel {
+            (self.constant, varying)
+        } else {
+            (varying, self.constant)
+        };
+        let mut e = [L::splat(0.0); 3];
+        for k in 0..3 {
+            e[k] = self.edges[k][0] + x * self.edges[k][1] + self.edge_y[k];
+        }
+        let active = active & facing.gt(L::splat(0.0));
+        let inside = (self.tri).inside_lanes(e, self.tolerance, active, x, self.y);
+        if inside == 0 {
+            return (0, [0.0; 8]);
+        }
+        depth_in(facing, volume, inside, self.limits)
     }
 }
 
@@ -856,6 +948,31 @@ impl Coverage for Bound3D<'_> {
     #[inline(always)]
     fn sample_points8<L: Lanes>(&self, x: [f32; 8], y: [f32; 8], active: u8) -> (u8, [f32; 8]) {
         self.sample_lanes(L::from_array(x), L::from_array(y), active)
+    }
+
+    #[inline(always)]
+    fn rows<L: Lanes>(&self) -> impl RowLanes<L> {
+        let t = self.t;
+        let zero = L::splat(0.0);
+        let mut edges = [[zero; 3]; 3];
+        for k in 0..3 {
+            edges[k] = [L::splat(t.a[k]), L::splat(t.b[k]), L::splat(t.c[k])];
+        }
+        Rows3D {
+            tri: self,
+            edges,
+            edge_y: [zero; 3],
+            tolerance: self.tolerance_lanes(),
+            varying: [
+                L::splat(t.varying[0]),
+                L::splat(t.varying[1]),
+                L::splat(t.varying[2]),
+            ],
+            varying_y: zero,
+            constant: L::splat(t.constant),
+            limits: self.depth_limits(),
+            y: zero,
+        }
     }
 
     /// Edges, facing, and `w ≥ near` as `volume ≥ near·facing`: no division

@@ -183,6 +183,13 @@ pub trait Coverage {
         self.sample_points8::<L>(x, [y; 8], active)
     }
 
+    /// The triangle's groups of eight samples along rows ([`RowLanes`]), with
+    /// what every group shares worked out once for many rows.
+    #[inline(always)]
+    fn rows<L: Lanes>(&self) -> impl RowLanes<L> {
+        ByGroups { tri: self, y: 0.0 }
+    }
+
     /// Coverage and depth of eight samples at any points `(x[k], y[k])` (the
     /// samples of anti-aliasing patterns, the rays of a packet), of which the
     /// lanes in `active` count: the same decisions as [`Coverage::sample`] per lane.
@@ -235,6 +242,37 @@ pub trait Coverage {
     fn min_depth(&self) -> f32;
 }
 
+/// A triangle's [`Coverage::sample8`] along rows of samples, group after
+/// group ([`Coverage::rows`]): the row's `y` set once, each group's points
+/// given as lanes. Bit for bit `sample8` at the same points.
+pub trait RowLanes<L: Lanes> {
+    /// The row at `y` (before the groups along it).
+    fn set_row(&mut self, y: f32);
+
+    /// [`Coverage::sample8`] at `x0, x0 + 1, …, x0 + 7` on the current row,
+    /// with those points in lanes (`x`).
+    fn sample8(&self, x0: f32, x: L, active: u8) -> (u8, [f32; 8]);
+}
+
+/// [`RowLanes`] as calls of [`Coverage::sample8`], for triangles with no
+/// row form of their own.
+struct ByGroups<'a, C: ?Sized> {
+    tri: &'a C,
+    y: f32,
+}
+
+impl<L: Lanes, C: Coverage + ?Sized> RowLanes<L> for ByGroups<'_, C> {
+    #[inline(always)]
+    fn set_row(&mut self, y: f32) {
+        self.y = y;
+    }
+
+    #[inline(always)]
+    fn sample8(&self, x0: f32, _: L, active: u8) -> (u8, [f32; 8]) {
+        self.tri.sample8::<L>(x0, self.y, active)
+    }
+}
+
 /// A reference reads as what it refers to (what [`Stored::bind`] gives the
 /// set-up triangles that are their own coverage).
 impl<C: Coverage> Coverage for &C {
@@ -246,6 +284,10 @@ impl<C: Coverage> Coverage for &C {
     #[inline(always)]
     fn sample8<L: Lanes>(&self, x0: f32, y: f32, active: u8) -> (u8, [f32; 8]) {
         (**self).sample8::<L>(x0, y, active)
+    }
+    #[inline(always)]
+    fn rows<L: Lanes>(&self) -> impl RowLanes<L> {
+        (**self).rows::<L>()
     }
     #[inline(always)]
     fn sample_points8<L: Lanes>(&self, x: [f32; 8], y: [f32; 8], active: u8) -> (u8, [f32; 8]) {
