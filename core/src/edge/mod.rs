@@ -431,7 +431,7 @@ pub fn linear_classify<T: LinearEdges>(t: &T, x0: f32, y0: f32, x1: f32, y1: f32
 /// its scalar ones.
 #[cfg(test)]
 pub(crate) mod lanes_test {
-    use super::Coverage;
+    use super::{Coverage, RowLanes};
     use crate::simd::Lanes;
 
     #[cfg(target_arch = "x86_64")]
@@ -440,16 +440,26 @@ pub(crate) mod lanes_test {
         lanes_agree::<crate::simd::Avx2, T>(t, active)
     }
 
-    /// Compares `t`'s `sample8`, `sample_points8`, `covers8` and `depth_inside8`
-    /// on lanes `L` with the scalar path over the 64×48 image (`covers8`,
+    /// Compares `t`'s `sample8` (and its row form, [`Coverage::rows`]),
+    /// `sample_points8`, `covers8` and `depth_inside8` on lanes `L` with the
+    /// scalar path over the 64×48 image (`covers8`,
     /// which skips the depth clamp, against the other lanes); returns the
     /// number of covered samples compared and the `covers8` masks.
     pub(crate) fn lanes_agree<L: Lanes, T: Coverage>(t: &T, active: u8) -> (usize, Vec<u8>) {
         let (mut compared, mut covers) = (0, Vec::new());
+        let mut rows = t.rows::<L>();
         for y in 0..48 {
             let yc = y as f32 + 0.5;
+            rows.set_row(yc);
             for x0 in (0..64).step_by(8) {
                 let (mask, depth) = t.sample8::<L>(x0 as f32 + 0.5, yc, active);
+                // The same group along the row form.
+                let x = L::from_array(std::array::from_fn(|k| (x0 + k) as f32 + 0.5));
+                let (row_mask, row_depth) = rows.sample8(x0 as f32 + 0.5, x, active);
+                assert_eq!(row_mask, mask, "row form: pixels from ({x0}, {y})");
+                for k in (0..8).filter(|k| mask >> k & 1 == 1) {
+                    assert_eq!(row_depth[k].to_bits(), depth[k].to_bits(), "row form depth");
+                }
                 // The same pixels as points, a quarter pixel off their centres.
                 let xs = std::array::from_fn(|k| (x0 + k) as f32 + 0.25);
                 let ys = [yc + 0.25; 8];
