@@ -7,8 +7,8 @@
 //! sample exactly on a vertex gets `E = 0` exactly on both of its edges.
 
 use super::{
-    BlockTest, Coverage, EdgeWalk, LinearEdges, inside_edge, linear_classify, linear_sample,
-    owns_tie,
+    BlockTest, Coverage, EdgeWalk, LinearEdges, RowLanes, inside_edge, linear_classify,
+    linear_sample, owns_tie,
 };
 use crate::simd::Lanes;
 
@@ -234,7 +234,13 @@ impl Triangle2D {
 
     #[inline(always)]
     fn sample_lanes<L: Lanes>(&self, x: L, y: L, active: u8) -> (u8, [f32; 8]) {
-        let e = self.edge_lanes(x, y);
+        self.decide_lanes(self.edge_lanes(x, y), active)
+    }
+
+    /// The lanes of `active` inside the edges with values `e` (the tie rule
+    /// on zeros), and their depths.
+    #[inline(always)]
+    fn decide_lanes<L: Lanes>(&self, e: [L; 3], active: u8) -> (u8, [f32; 8]) {
         let zero = L::splat(0.0);
         let mut inside = active;
         for (i, &e) in e.iter().enumerate() {
@@ -248,6 +254,38 @@ impl Triangle2D {
     }
 }
 
+/// A [`Triangle2D`] along rows ([`RowLanes`]): its coefficients splatted
+/// into lanes once, and per row each edge's `Δx·(y − ly)`, so that a group's
+/// edge values are [`Triangle2D::edge_lane`]'s with no per-group loads.
+pub(crate) struct Rows2D<'a, L> {
+    tri: &'a Triangle2D,
+    /// Per edge: `lx`, `Δy`, the sign; then the row's `Δx·(y − ly)`.
+    edges: [[L; 3]; 3],
+    edge_y: [L; 3],
+}
+
+impl<L: Lanes> RowLanes<L> for Rows2D<'_, L> {
+    #[inline(always)]
+    fn set_row(&mut self, y: f32) {
+        let y = L::splat(y);
+        for i in 0..3 {
+            let ([_, ly], [dx, _]) = (self.tri.lo[i], self.tri.delta[i]);
+            self.edge_y[i] = L::splat(dx) * (y - L::splat(ly));
+        }
+    }
+
+    /// [`Triangle2D::sample_lanes`] with the row's terms.
+    #[inline(always)]
+    fn sample8(&self, _: f32, x: L, active: u8) -> (u8, [f32; 8]) {
+        let mut e = [L::splat(0.0); 3];
+        for i in 0..3 {
+            let [lx, dy, sign] = self.edges[i];
+            e[i] = (self.edge_y[i] - dy * (x - lx)) * sign;
+        }
+        self.tri.decide_lanes(e, active)
+    }
+}
+
 impl Coverage for Triangle2D {
     #[inline(always)]
     fn sample(&self, x: f32, y: f32) -> Option<f32> {
@@ -257,6 +295,21 @@ impl Coverage for Triangle2D {
     #[inline(always)]
     fn sample_points8<L: Lanes>(&self, x: [f32; 8], y: [f32; 8], active: u8) -> (u8, [f32; 8]) {
         self.sample_lanes(L::from_array(x), L::from_array(y), active)
+    }
+
+    #[inline(always)]
+    fn rows<L: Lanes>(&self) -> impl RowLanes<L> {
+        let zero = L::splat(0.0);
+        let mut edges = [[zero; 3]; 3];
+        for (i, edge) in edges.iter_mut().enumerate() {
+            let ([lx, _], [_, dy]) = (self.lo[i], self.delta[i]);
+            *edge = [L::splat(lx), L::splat(dy), L::splat(self.sign[i])];
+        }
+        Rows2D {
+            tri: self,
+            edges,
+            edge_y: [zero; 3],
+        }
     }
 
     #[inline(always)]
