@@ -278,9 +278,9 @@ impl<L: Lanes> RowLanes<L> for Rows2D<'_, L> {
     #[inline(always)]
     fn sample8(&self, _: f32, x: L, active: u8) -> (u8, [f32; 8]) {
         let mut e = [L::splat(0.0); 3];
-        for i in 0..3 {
+        for (i, e) in e.iter_mut().enumerate() {
             let [lx, dy, sign] = self.edges[i];
-            e[i] = (self.edge_y[i] - dy * (x - lx)) * sign;
+            *e = (self.edge_y[i] - dy * (x - lx)) * sign;
         }
         self.tri.decide_lanes(e, active)
     }

@@ -775,8 +775,8 @@ impl Bound3D<'_> {
     fn edges_lanes<L: Lanes>(&self, x: L, y: L, active: u8) -> u8 {
         let t = self.t;
         let mut e = [L::splat(0.0); 3];
-        for k in 0..3 {
-            e[k] = Self::linear_lanes([t.a[k], t.b[k], t.c[k]], x, y);
+        for (k, e) in e.iter_mut().enumerate() {
+            *e = Self::linear_lanes([t.a[k], t.b[k], t.c[k]], x, y);
         }
         self.inside_lanes(e, self.tolerance_lanes(), active, x, y)
     }
@@ -894,8 +894,9 @@ impl<L: Lanes> RowLanes<L> for Rows3D<'_, L> {
             (varying, self.constant)
         };
         let mut e = [L::splat(0.0); 3];
-        for k in 0..3 {
-            e[k] = self.edges[k][0] + x * self.edges[k][1] + self.edge_y[k];
+        for (k, e) in e.iter_mut().enumerate() {
+            let [a, b, _] = self.edges[k];
+            *e = a + x * b + self.edge_y[k];
         }
         let active = active & facing.gt(L::splat(0.0));
         let inside = (self.tri).inside_lanes(e, self.tolerance, active, x, self.y);
@@ -955,8 +956,8 @@ impl Coverage for Bound3D<'_> {
         let t = self.t;
         let zero = L::splat(0.0);
         let mut edges = [[zero; 3]; 3];
-        for k in 0..3 {
-            edges[k] = [L::splat(t.a[k]), L::splat(t.b[k]), L::splat(t.c[k])];
+        for (k, edge) in edges.iter_mut().enumerate() {
+            *edge = [L::splat(t.a[k]), L::splat(t.b[k]), L::splat(t.c[k])];
         }
         Rows3D {
             tri: self,
