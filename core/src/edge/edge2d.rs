@@ -257,7 +257,7 @@ impl Triangle2D {
 /// A [`Triangle2D`] along rows ([`RowLanes`]): its coefficients splatted
 /// into lanes once, and per row each edge's `Δx·(y − ly)`, so that a group's
 /// edge values are [`Triangle2D::edge_lane`]'s with no per-group loads.
-pub(crate) struct Rows2D<'a, L> {
+struct Rows2D<'a, L> {
     tri: &'a Triangle2D,
     /// Per edge: `lx`, `Δy`, the sign; then the row's `Δx·(y − ly)`.
     edges: [[L; 3]; 3],

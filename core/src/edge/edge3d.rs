@@ -858,7 +858,7 @@ fn depth_in<L: Lanes>(facing: L, volume: L, mask: u8, limits: [L; 3]) -> (u8, [f
 /// lanes once, and per row the `y·C` terms, so that a group's values are
 /// `(A + x·B) + y·C` in [`Bound3D::linear_lanes`]'s order with no per-group
 /// loads or decoding.
-pub(crate) struct Rows3D<'a, L> {
+struct Rows3D<'a, L> {
     tri: &'a Bound3D<'a>,
     /// Per edge: `A`, `B`, and `C` splatted; then the row's `y·C`.
     edges: [[L; 3]; 3],
