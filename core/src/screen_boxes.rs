@@ -367,6 +367,12 @@ impl ScreenBoxes {
         ScreenBoxes::of(&scene.scene.mesh.positions, view)
     }
 
+    /// The boxes of triangles by BVH slot: over the slot-numbered vertices
+    /// (`PreparedScene::slot_vertices` index these points).
+    pub(crate) fn of_slots(scene: &PreparedScene, view: &View) -> ScreenBoxes {
+        ScreenBoxes::of(&scene.slot_positions, view)
+    }
+
     /// The boxes of triangles over mesh vertices `positions`.
     pub(crate) fn of(positions: &[Vec3], view: &View) -> ScreenBoxes {
         let map = view.sphere.is_none().then(|| ImageMap::new(view));

@@ -228,7 +228,8 @@ fn render_frusta<'a, T: Stored + Copy>(
     setup: Setup<'a, T>,
 ) -> Pass {
     let start = Instant::now();
-    let boxes = ScreenBoxes::new(scene, context.view);
+    // Leaves box their triangles by slot.
+    let boxes = ScreenBoxes::of_slots(scene, context.view);
     let boxes = &boxes;
     let mut pass = Pass::default();
     let rects = fb.tile_rects(oracles.frustum, oracles.frustum);

@@ -41,11 +41,11 @@ pub(crate) fn setup_slots_3d<'a>(
     span: SampleSpan,
 ) -> Setups<'a, Triangle3D> {
     let shared = slot_shared_3d(scene, view);
-    let positions = &scene.scene.mesh.positions;
+    let positions = &scene.slot_positions;
     if !LaneMesh::applies(view, positions, &scene.slot_vertices) {
         return setup_slots(scene, view, span, shared, Triangle3D::setup_eight);
     }
-    let boxes = ScreenBoxes::new(scene, view);
+    let boxes = ScreenBoxes::of_slots(scene, view);
     let lanes = LaneMesh::new(&boxes, positions, &scene.slot_vertices, view, span);
     set_up_in_lanes(&lanes, &scene.slot_triangles, true, shared)
 }
@@ -266,8 +266,8 @@ pub(crate) fn setup_slots<'a, T: Stored>(
     shared: T::Shared<'a>,
     setup: impl SetupEight<'a, T>,
 ) -> Setups<'a, T> {
-    let boxes = ScreenBoxes::new(scene, view);
-    let positions = &scene.scene.mesh.positions;
+    let boxes = ScreenBoxes::of_slots(scene, view);
+    let positions = &scene.slot_positions;
     let chunks = (scene.slot_corners.par_chunks(8))
         .zip(scene.slot_vertices.par_chunks(8))
         .zip(scene.slot_triangles.par_chunks(8));
