@@ -499,14 +499,17 @@ impl<'p> TileBuffer<'p> {
     /// the writes one by one.
     #[inline(always)]
     pub(crate) fn write_eight<L: Lanes>(&mut self, i: usize, mask: u8, w: &[f32; 8], id: u32) {
-        let Some(stored) = self.depth.get(i..i + 8) else {
+        let (Some(stored), Some(stored_ids)) =
+            (self.depth.get(i..i + 8), self.triangle_id.get(i..i + 8))
+        else {
             return self.write_each(i, mask, w, id);
         };
         if is_see_through(self.opacity, id) {
             return self.write_each(i, mask, w, id);
         }
-        let mut old = [0.0; 8];
+        let (mut old, mut old_ids) = ([0.0; 8], [0u32; 8]);
         old.copy_from_slice(stored);
+        old_ids.copy_from_slice(stored_ids);
         let (new, stored) = (L::from_array(*w), L::from_array(old));
         let nearer = new.lt(stored) & mask;
         // Equal depths: the smaller id wins (rare: decided one by one).
@@ -514,7 +517,7 @@ impl<'p> TileBuffer<'p> {
         while ties != 0 {
             let l = ties.trailing_zeros() as usize;
             ties &= ties - 1;
-            if id < self.triangle_id[i + l] {
+            if id < old_ids[l] {
                 wins |= 1 << l;
             }
         }
@@ -527,12 +530,12 @@ impl<'p> TileBuffer<'p> {
         }
         self.depth_lowered |= nearer != 0;
         self.depth[i..i + 8].copy_from_slice(&L::select(wins, new, stored).to_array());
-        let ids = &mut self.triangle_id[i..i + 8];
-        for (l, stored_id) in ids.iter_mut().enumerate() {
-            if wins >> l & 1 != 0 {
-                *stored_id = id;
-            }
-        }
+        // The ids blended as lanes of bits (a select moves bits, whatever
+        // float they spell), not stored lane by lane behind a branch each.
+        let old_ids = L::from_array(bytemuck::cast(old_ids));
+        let ids = L::select(wins, L::splat(f32::from_bits(id)), old_ids);
+        (self.triangle_id[i..i + 8])
+            .copy_from_slice(&bytemuck::cast::<_, [u32; 8]>(ids.to_array()));
     }
 
     /// [`TileBuffer::write`] of each lane of `mask`, in lane order.
@@ -663,5 +666,41 @@ mod tests {
         }
         assert_eq!(checked, 4_000);
         assert!(lowered > 1_000, "{lowered} groups lowered a depth");
+    }
+
+    /// The ids `write_eight` blends as float lanes keep their bits, those
+    /// that spell a signalling or quiet NaN, an infinity or a subnormal
+    /// included, on the portable lanes and the dispatched ones.
+    #[test]
+    fn eight_writes_keep_every_id_bit() {
+        let pattern = AaMode::None.pattern();
+        let ids = [
+            0x7F80_0001,
+            0xFFC0_0000,
+            0x7F80_0000,
+            1,
+            0x8000_0001,
+            0x7FBF_FFFF,
+        ];
+        let mut checked = 0;
+        for (k, &id) in ids.iter().enumerate() {
+            let old = ids[(k + 1) % ids.len()];
+            let mut tile = TileBuffer::new(PixelRect::new(0, 0, 8, 1), &pattern, &[]);
+            for s in 0..8 {
+                tile.write(s, 2.0, old);
+            }
+            let mut portable = tile.clone();
+            // Lanes 0, 2, 4, 6 nearer; the others behind.
+            let w = [1.0, 3.0, 1.0, 3.0, 1.0, 3.0, 1.0, 3.0];
+            portable.write_eight::<Portable>(0, u8::MAX, &w, id);
+            write_eight_dispatched(&mut tile, 0, u8::MAX, &w, id);
+            for t in [&portable, &tile] {
+                let expected: Vec<u32> =
+                    (0..8).map(|l| if l % 2 == 0 { id } else { old }).collect();
+                assert_eq!(t.triangle_id, expected, "id {id:#x} over {old:#x}");
+            }
+            checked += 1;
+        }
+        assert_eq!(checked, ids.len());
     }
 }
