@@ -26,11 +26,11 @@ pub struct PreparedScene {
     /// Triangle id of each BVH primitive slot: `drawable[primitive_indices[slot]]`,
     /// so per-slot data sits in the order leaves read it.
     pub(crate) slot_triangles: Vec<u32>,
-    /// Per slot: its triangle's positions and vertex indices, so a per-view
-    /// setup in slot order reads memory in order instead of gathering from
-    /// the mesh.
+    /// Per slot: its triangle's positions, so a per-view setup in slot
+    /// order reads memory in order instead of gathering from the mesh.
     pub(crate) slot_corners: Vec<[Vec3; 3]>,
-    /// Indices into [`PreparedScene::slot_positions`], not the mesh's.
+    /// Per slot: its triangle's vertex indices into
+    /// [`PreparedScene::slot_positions`] (not the mesh's).
     pub(crate) slot_vertices: Vec<[u32; 3]>,
     /// The drawable triangles' vertex positions numbered in the order the
     /// slots first use them: a setup in slot order that gathers its
@@ -231,4 +231,48 @@ const NO_SLOT: u32 = u32::MAX;
 #[inline(always)]
 pub(crate) fn is_see_through(opacity: &[f32], id: u32) -> bool {
     !opacity.is_empty() && opacity[id as usize] < 1.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Renumbered vertices spell the same corners, are numbered in the
+    /// order of first use (each new one the next number), and only the
+    /// vertices used are kept.
+    #[test]
+    fn vertices_are_renumbered_in_order_of_first_use() {
+        let positions: Vec<Vec3> = (0..6).map(|i| Vec3::splat(i as f32)).collect();
+        let triangles = [[0, 1, 2], [2, 3, 4], [4, 1, 0]];
+        // Vertex 5 is used by no listed triangle.
+        let ids = [2, 0, 1];
+        let (vertices, order) = renumbered(&ids, &triangles, &positions);
+        assert_eq!(vertices, vec![[0, 1, 2], [2, 1, 3], [3, 4, 0]]);
+        assert_eq!(order.len(), 5);
+        for (k, &id) in ids.iter().enumerate() {
+            let corners = vertices[k].map(|v| order[v as usize]);
+            assert_eq!(
+                corners,
+                triangles[id as usize].map(|v| positions[v as usize])
+            );
+        }
+    }
+
+    /// A built-in scene's slots find their corners through the renumbered
+    /// vertices, slot by slot.
+    #[test]
+    fn slot_vertices_spell_the_slot_corners() {
+        let path = format!("{}/../scenes/sphere.toml", env!("CARGO_MANIFEST_DIR"));
+        let scene = crate::scene::load_path(path.as_ref()).expect("built-in scene loads");
+        let prepared = PreparedScene::new(scene);
+        let mut checked = 0;
+        for (slot, corners) in prepared.slot_corners.iter().enumerate() {
+            let renumbered =
+                prepared.slot_vertices[slot].map(|v| prepared.slot_positions[v as usize]);
+            assert_eq!(&renumbered, corners, "slot {slot}");
+            checked += 1;
+        }
+        assert_eq!(checked, prepared.drawable.len());
+        assert!(prepared.slot_positions.len() <= prepared.scene.mesh.positions.len());
+    }
 }
