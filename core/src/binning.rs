@@ -147,10 +147,27 @@ fn sample_rows<L: Lanes, T: Coverage>(
         }
         return covered;
     }
-    // Eight samples at a time, written (depth-tested) eight at a time, the
-    // triangle's lanes set out once. The points `x0 + k` are integers and a
-    // half, exact in f32, so stepping the lanes by eight forms each group's
-    // points as `sample8` would.
+    along_rows::<L, T>(tile, tri, id, r, Samples::Test)
+}
+
+/// One sample per pixel: the samples of `r` eight at a time along its rows
+/// through the triangle's row form ([`Coverage::rows`]: its lanes set out
+/// once), written (depth-tested) eight at a time where a row holds a group
+/// and one by one where it is shorter. The points `x0 + k` are integers and
+/// a half, exact in f32, so stepping the lanes by eight forms each group's
+/// points as `sample8` would. Returns the number of samples covered.
+#[inline(always)]
+fn along_rows<L: Lanes, T: Coverage>(
+    tile: &mut TileBuffer,
+    tri: &T,
+    id: u32,
+    r: PixelRect,
+    how: Samples,
+) -> u32 {
+    debug_assert_eq!(tile.pattern.coverage(), 1);
+    let mut covered = 0;
+    let n = r.width();
+    let x0 = r.x0 as f32 + 0.5;
     let mut rows = tri.rows::<L>();
     let first = L::from_array([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]) + L::splat(x0);
     for y in r.y0..r.y1 {
@@ -160,10 +177,23 @@ fn sample_rows<L: Lanes, T: Coverage>(
         let mut x = first;
         for k in (0..n).step_by(8) {
             let active = first_lanes((n - k) as usize);
-            let (mask, w) = rows.sample8(x0 + k as f32, x, active);
+            let (mask, w) = match how {
+                Samples::Test => rows.sample8(x0 + k as f32, x, active),
+                Samples::Inside => {
+                    let (mask, w) = rows.depth_inside8(x);
+                    (mask & active, w)
+                }
+            };
             x = x + L::splat(8.0);
-            if mask != 0 {
-                covered += mask.count_ones();
+            covered += mask.count_ones();
+            if n < 8 {
+                let mut lanes = mask;
+                while lanes != 0 {
+                    let l = lanes.trailing_zeros() as usize;
+                    lanes &= lanes - 1;
+                    tile.write(i + l, w[l], id);
+                }
+            } else if mask != 0 {
                 tile.write_eight::<L>(i + k as usize, mask, &w, id);
             }
         }
@@ -235,7 +265,10 @@ fn fill_samples_on<L: Lanes, T: Coverage>(
     id: u32,
     r: PixelRect,
 ) -> u32 {
-    sample_pattern::<L, T>(tile, tri, id, r, Samples::Inside)
+    if tile.pattern.coverage() > 1 {
+        return sample_pattern::<L, T>(tile, tri, id, r, Samples::Inside);
+    }
+    along_rows::<L, T>(tile, tri, id, r, Samples::Inside)
 }
 
 /// What [`sample_pattern`] evaluates per sample.

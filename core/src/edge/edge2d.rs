@@ -277,12 +277,25 @@ impl<L: Lanes> RowLanes<L> for Rows2D<'_, L> {
     /// [`Triangle2D::sample_lanes`] with the row's terms.
     #[inline(always)]
     fn sample8(&self, _: f32, x: L, active: u8) -> (u8, [f32; 8]) {
+        self.tri.decide_lanes(self.edge_values(x), active)
+    }
+
+    #[inline(always)]
+    fn depth_inside8(&self, x: L) -> (u8, [f32; 8]) {
+        self.tri.depth_lanes(self.edge_values(x), 0xff)
+    }
+}
+
+impl<L: Lanes> Rows2D<'_, L> {
+    /// [`Triangle2D::edge_lanes`] with the row's terms.
+    #[inline(always)]
+    fn edge_values(&self, x: L) -> [L; 3] {
         let mut e = [L::splat(0.0); 3];
         for (i, e) in e.iter_mut().enumerate() {
             let [lx, dy, sign] = self.edges[i];
             *e = (self.edge_y[i] - dy * (x - lx)) * sign;
         }
-        self.tri.decide_lanes(e, active)
+        e
     }
 }
 

@@ -886,13 +886,7 @@ impl<L: Lanes> RowLanes<L> for Rows3D<'_, L> {
     /// [`Bound3D::sample_lanes`] with the row's terms.
     #[inline(always)]
     fn sample8(&self, _: f32, x: L, active: u8) -> (u8, [f32; 8]) {
-        let [k0, k1, _] = self.varying;
-        let varying = k0 + x * k1 + self.varying_y;
-        let (facing, volume) = if self.tri.shared.parallel {
-            (self.constant, varying)
-        } else {
-            (varying, self.constant)
-        };
+        let (facing, volume) = self.facing_and_volume(x);
         let mut e = [L::splat(0.0); 3];
         for (k, e) in e.iter_mut().enumerate() {
             let [a, b, _] = self.edges[k];
@@ -904,6 +898,27 @@ impl<L: Lanes> RowLanes<L> for Rows3D<'_, L> {
             return (0, [0.0; 8]);
         }
         depth_in(facing, volume, inside, self.limits)
+    }
+
+    /// [`Coverage::depth_inside8`] of [`Bound3D`] with the row's terms.
+    #[inline(always)]
+    fn depth_inside8(&self, x: L) -> (u8, [f32; 8]) {
+        let (facing, volume) = self.facing_and_volume(x);
+        depth_in(facing, volume, facing.gt(L::splat(0.0)), self.limits)
+    }
+}
+
+impl<L: Lanes> Rows3D<'_, L> {
+    /// [`Bound3D::facing_and_volume_lanes`] with the row's terms.
+    #[inline(always)]
+    fn facing_and_volume(&self, x: L) -> (L, L) {
+        let [k0, k1, _] = self.varying;
+        let varying = k0 + x * k1 + self.varying_y;
+        if self.tri.shared.parallel {
+            (self.constant, varying)
+        } else {
+            (varying, self.constant)
+        }
     }
 }
 

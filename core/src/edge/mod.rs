@@ -252,6 +252,10 @@ pub trait RowLanes<L: Lanes> {
     /// [`Coverage::sample8`] at `x0, x0 + 1, …, x0 + 7` on the current row,
     /// with those points in lanes (`x`).
     fn sample8(&self, x0: f32, x: L, active: u8) -> (u8, [f32; 8]);
+
+    /// [`Coverage::depth_inside8`] at the same points (a group known to be
+    /// inside the edges).
+    fn depth_inside8(&self, x: L) -> (u8, [f32; 8]);
 }
 
 /// [`RowLanes`] as calls of [`Coverage::sample8`], for triangles with no
@@ -270,6 +274,11 @@ impl<L: Lanes, C: Coverage + ?Sized> RowLanes<L> for ByGroups<'_, C> {
     #[inline(always)]
     fn sample8(&self, x0: f32, _: L, active: u8) -> (u8, [f32; 8]) {
         self.tri.sample8::<L>(x0, self.y, active)
+    }
+
+    #[inline(always)]
+    fn depth_inside8(&self, x: L) -> (u8, [f32; 8]) {
+        self.tri.depth_inside8::<L>(x.to_array(), [self.y; 8])
     }
 }
 
@@ -440,7 +449,8 @@ pub(crate) mod lanes_test {
         lanes_agree::<crate::simd::Avx2, T>(t, active)
     }
 
-    /// Compares `t`'s `sample8` (and its row form, [`Coverage::rows`]),
+    /// Compares `t`'s `sample8` (and its row form, [`Coverage::rows`], with
+    /// the row form's `depth_inside8`),
     /// `sample_points8`, `covers8` and `depth_inside8` on lanes `L` with the
     /// scalar path over the 64×48 image (`covers8`,
     /// which skips the depth clamp, against the other lanes); returns the
@@ -459,6 +469,14 @@ pub(crate) mod lanes_test {
                 assert_eq!(row_mask, mask, "row form: pixels from ({x0}, {y})");
                 for k in (0..8).filter(|k| mask >> k & 1 == 1) {
                     assert_eq!(row_depth[k].to_bits(), depth[k].to_bits(), "row form depth");
+                }
+                let xs = x.to_array();
+                let (inside_mask, inside_depth) = t.depth_inside8::<L>(xs, [yc; 8]);
+                let (row_mask, row_depth) = rows.depth_inside8(x);
+                assert_eq!(row_mask, inside_mask, "row form inside: from ({x0}, {y})");
+                for k in (0..8).filter(|k| inside_mask >> k & 1 == 1) {
+                    let [row, lane] = [row_depth[k], inside_depth[k]].map(f32::to_bits);
+                    assert_eq!(row, lane, "row form inside depth");
                 }
                 // The same pixels as points, a quarter pixel off their centres.
                 let xs = std::array::from_fn(|k| (x0 + k) as f32 + 0.25);
