@@ -150,12 +150,12 @@ fn sample_rows<L: Lanes, T: Coverage>(
     along_rows::<L, T>(tile, tri, id, r, Samples::Test)
 }
 
-/// One sample per pixel: the samples of `r` eight at a time along its rows
-/// through the triangle's row form ([`Coverage::rows`]: its lanes set out
-/// once), written (depth-tested) eight at a time where a row holds a group
-/// and one by one where it is shorter. The points `x0 + k` are integers and
-/// a half, exact in f32, so stepping the lanes by eight forms each group's
-/// points as `sample8` would. Returns the number of samples covered.
+/// One sample per pixel: the samples of `r` (rows of at least a group)
+/// eight at a time along its rows through the triangle's row form
+/// ([`Coverage::rows`]: its lanes set out once), written (depth-tested)
+/// eight at a time. The points `x0 + k` are integers and a half, exact in
+/// f32, so stepping the lanes by eight forms each group's points as
+/// `sample8` would. Returns the number of samples covered.
 #[inline(always)]
 fn along_rows<L: Lanes, T: Coverage>(
     tile: &mut TileBuffer,
@@ -167,6 +167,7 @@ fn along_rows<L: Lanes, T: Coverage>(
     debug_assert_eq!(tile.pattern.coverage(), 1);
     let mut covered = 0;
     let n = r.width();
+    debug_assert!(n >= 8, "rows shorter than a group take sample_run");
     let x0 = r.x0 as f32 + 0.5;
     let mut rows = tri.rows::<L>();
     let first = L::from_array([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]) + L::splat(x0);
@@ -185,15 +186,8 @@ fn along_rows<L: Lanes, T: Coverage>(
                 }
             };
             x = x + L::splat(8.0);
-            covered += mask.count_ones();
-            if n < 8 {
-                let mut lanes = mask;
-                while lanes != 0 {
-                    let l = lanes.trailing_zeros() as usize;
-                    lanes &= lanes - 1;
-                    tile.write(i + l, w[l], id);
-                }
-            } else if mask != 0 {
+            if mask != 0 {
+                covered += mask.count_ones();
                 tile.write_eight::<L>(i + k as usize, mask, &w, id);
             }
         }
