@@ -439,11 +439,10 @@ impl ScreenBoxes {
         };
         let mut projected = 0;
         if self.map.is_some() {
-            let flat = self.points.as_flattened();
             let points = [
-                gathered_point::<L>(flat, vertices[0]),
-                gathered_point::<L>(flat, vertices[1]),
-                gathered_point::<L>(flat, vertices[2]),
+                gathered_point::<L>(&self.points, vertices[0]),
+                gathered_point::<L>(&self.points, vertices[1]),
+                gathered_point::<L>(&self.points, vertices[2]),
             ];
             // A point is projected where its x is finite.
             projected =
@@ -541,15 +540,12 @@ fn node_rects_eight_on<L: Lanes>(
     map.box_rects::<L>(&lo, &hi, view, span)
 }
 
-/// The packed points ([`ImagePoint::packed`]) of vertices `v`, one per lane,
-/// from the flat array of them: x, y and rounding bound.
+/// The packed points ([`ImagePoint::packed`]) of vertices `v`, one per lane:
+/// x, y and rounding bound.
 #[inline(always)]
-fn gathered_point<L: Lanes>(flat: &[f32], v: [u32; 8]) -> [L; 3] {
-    [
-        L::gather(flat, strided(v, 4, 0)),
-        L::gather(flat, strided(v, 4, 1)),
-        L::gather(flat, strided(v, 4, 2)),
-    ]
+fn gathered_point<L: Lanes>(points: &[[f32; 4]], v: [u32; 8]) -> [L; 3] {
+    let [x, y, bound, _] = L::gather_xyzw(points, v);
+    [x, y, bound]
 }
 
 simd::dispatch! {
@@ -654,14 +650,6 @@ pub(crate) fn pixels_lanes<L: Lanes>(
         pad = pad.max(p);
     }
     padded_rects([min_x, min_y, max_x, max_y], pad, [width, height], span)
-}
-
-/// Lane `l` of each of `index`'s lanes times `stride` plus `field`: where
-/// field `field` of record `index[l]` sits in a flat array of records of
-/// `stride` values. Callers keep `index · stride + field` below 2³².
-#[inline(always)]
-pub(crate) fn strided(index: [u32; 8], stride: u32, field: u32) -> [u32; 8] {
-    index.map(|i| i.wrapping_mul(stride).wrapping_add(field))
 }
 
 /// `r · v` for eight vectors `v` (per axis), as `Vec3::dot` rounds it:

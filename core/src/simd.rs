@@ -82,8 +82,15 @@ mod sealed {
         /// `base[index[l]]` in lane `l`; panics, as indexing does, when an
         /// index is out of bounds.
         fn gather(base: &[f32], index: [u32; 8]) -> Self;
-        /// [`Ops::gather`] of `u32`s.
-        fn gather_u32(base: &[u32], index: [u32; 8]) -> [u32; 8];
+        /// Fields 0, 1 and 2 of the rows `index` of `base` read as rows of
+        /// `stride` (at least 3) floats: `base[stride·index[l] + k]` in lane
+        /// `l` of field `k`, as three [`Ops::gather`]s of them read it
+        /// (and panicking where they would).
+        fn gather_xyz(base: &[f32], stride: u32, index: [u32; 8]) -> [Self; 3];
+        /// The four fields of the rows `index` of `base`: `base[index[l]][k]`
+        /// in lane `l` of field `k`; panics, as indexing does, when an
+        /// index is out of bounds.
+        fn gather_xyzw(base: &[[f32; 4]], index: [u32; 8]) -> [Self; 4];
     }
 }
 
@@ -159,9 +166,27 @@ impl sealed::Ops for Portable {
         Self::from_array(index.map(|i| base[i as usize]))
     }
     #[inline(always)]
-    fn gather_u32(base: &[u32], index: [u32; 8]) -> [u32; 8] {
-        index.map(|i| base[i as usize])
+    fn gather_xyz(base: &[f32], stride: u32, index: [u32; 8]) -> [Self; 3] {
+        let at = |k: u32| index.map(|i| i.wrapping_mul(stride).wrapping_add(k));
+        [0, 1, 2].map(|k| Self::gather(base, at(k)))
     }
+    #[inline(always)]
+    fn gather_xyzw(base: &[[f32; 4]], index: [u32; 8]) -> [Self; 4] {
+        let rows = index.map(|i| base[i as usize]);
+        [0, 1, 2, 3].map(|k| Self::from_array(rows.map(|r| r[k])))
+    }
+}
+
+/// [`Ops::gather_xyz`] of `u32`s: the bits of fields 0, 1 and 2 of the rows
+/// `index` of `base`, rows of `stride` (at least 3).
+#[inline(always)]
+pub(crate) fn gather_xyz_u32<L: Lanes>(
+    base: &[u32],
+    stride: u32,
+    index: [u32; 8],
+) -> [[u32; 8]; 3] {
+    L::gather_xyz(bytemuck::cast_slice(base), stride, index)
+        .map(|field| bytemuck::cast(field.to_array()))
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -300,13 +325,77 @@ mod avx2_lanes {
             Avx2(unsafe { _mm256_i32gather_ps::<4>(base.as_ptr(), index) })
         }
         #[inline(always)]
-        fn gather_u32(base: &[u32], index: [u32; 8]) -> [u32; 8] {
-            let index = in_bounds(index, base.len());
-            // SAFETY: as in `gather`; `u32` and `i32` have one layout.
-            let v = unsafe { _mm256_i32gather_epi32::<4>(base.as_ptr().cast(), index) };
-            // SAFETY: `__m256i` and `[u32; 8]` are both 32 bytes.
-            unsafe { std::mem::transmute::<__m256i, [u32; 8]>(v) }
+        fn gather_xyz(base: &[f32], stride: u32, index: [u32; 8]) -> [Self; 3] {
+            let offsets = index.map(|i| i.wrapping_mul(stride));
+            // Each row read whole, four floats in one load, where every row
+            // has a fourth float after its three (all but a last row of
+            // three): a load a row beats a gather a field.
+            if !all_below(offsets, base.len().saturating_sub(3)) {
+                return [0, 1, 2].map(|k| Self::gather(base, offsets.map(|o| o.wrapping_add(k))));
+            }
+            // SAFETY: every offset `o` is below `base.len() − 3`, so the
+            // four floats from `o` lie in `base`.
+            let [x, y, z, _] = unsafe { transposed(base.as_ptr(), offsets, 1) };
+            [x, y, z]
         }
+        #[inline(always)]
+        fn gather_xyzw(base: &[[f32; 4]], index: [u32; 8]) -> [Self; 4] {
+            if !all_below(index, base.len()) {
+                panic!(
+                    "gather index out of bounds: {index:?} for length {}",
+                    base.len()
+                );
+            }
+            // SAFETY: every index is below `base.len()`, so the four floats
+            // of row `index[l]`, from float `4·index[l]`, lie in `base`.
+            unsafe { transposed(base.as_flattened().as_ptr(), index, 4) }
+        }
+    }
+
+    /// The four floats from `base + stride·index[l]` in lane `l`, field by
+    /// field: one 16-byte load per lane and a 4×4 transpose in each half.
+    ///
+    /// # Safety
+    /// For every lane, the four floats from `base + stride·index[l]` lie in
+    /// one live allocation; the CPU has AVX2.
+    #[inline(always)]
+    unsafe fn transposed(base: *const f32, index: [u32; 8], stride: usize) -> [Avx2; 4] {
+        // Lanes `a` and `b` (= a + 4) side by side: the halves transpose apart.
+        macro_rules! pair {
+            ($a:expr, $b:expr) => {
+                _mm256_insertf128_ps::<1>(
+                    _mm256_castps128_ps256(_mm_loadu_ps(base.add(index[$a] as usize * stride))),
+                    _mm_loadu_ps(base.add(index[$b] as usize * stride)),
+                )
+            };
+        }
+        // SAFETY: the caller's: each load reads four floats of one
+        // allocation; the shuffles take and return registers only.
+        unsafe {
+            let (t0, t1, t2, t3) = (pair!(0, 4), pair!(1, 5), pair!(2, 6), pair!(3, 7));
+            let (xy01, zw01) = (_mm256_unpacklo_ps(t0, t1), _mm256_unpackhi_ps(t0, t1));
+            let (xy23, zw23) = (_mm256_unpacklo_ps(t2, t3), _mm256_unpackhi_ps(t2, t3));
+            [
+                Avx2(_mm256_shuffle_ps::<0x44>(xy01, xy23)),
+                Avx2(_mm256_shuffle_ps::<0xEE>(xy01, xy23)),
+                Avx2(_mm256_shuffle_ps::<0x44>(zw01, zw23)),
+                Avx2(_mm256_shuffle_ps::<0xEE>(zw01, zw23)),
+            ]
+        }
+    }
+
+    /// Whether every lane of `v` is below `len` (unsigned).
+    #[inline(always)]
+    fn all_below(v: [u32; 8], len: usize) -> bool {
+        let Some(last) = len.min(i32::MAX as usize).checked_sub(1) else {
+            return false;
+        };
+        // SAFETY: `[u32; 8]` and `__m256i` are both 32 bytes.
+        let v = unsafe { std::mem::transmute::<[u32; 8], __m256i>(v) };
+        let last = avx!(_mm256_set1_epi32(last as i32));
+        // Every lane `≤ last` (unsigned): its minimum with `last` is itself.
+        let below = avx!(_mm256_cmpeq_epi32(_mm256_min_epu32(v, last), v));
+        avx!(_mm256_movemask_epi8(below)) == -1
     }
 
     /// `index` as a register of i32 lanes, after checking that every lane is
@@ -315,19 +404,14 @@ mod avx2_lanes {
     /// otherwise.
     #[inline(always)]
     fn in_bounds(index: [u32; 8], len: usize) -> __m256i {
-        // SAFETY: `[u32; 8]` and `__m256i` are both 32 bytes.
-        let v = unsafe { std::mem::transmute::<[u32; 8], __m256i>(index) };
-        let last = len.min(i32::MAX as usize).checked_sub(1);
-        let Some(last) = last else {
+        if len == 0 {
             panic!("gather from an empty slice");
-        };
-        let last = avx!(_mm256_set1_epi32(last as i32));
-        // Every lane `≤ last` (unsigned): its minimum with `last` is itself.
-        let below = avx!(_mm256_cmpeq_epi32(_mm256_min_epu32(v, last), v));
-        if avx!(_mm256_movemask_epi8(below)) != -1 {
+        }
+        if !all_below(index, len) {
             panic!("gather index out of bounds: {index:?} for length {len}");
         }
-        v
+        // SAFETY: `[u32; 8]` and `__m256i` are both 32 bytes.
+        unsafe { std::mem::transmute::<[u32; 8], __m256i>(index) }
     }
 }
 
@@ -468,38 +552,84 @@ pub(crate) fn prefetch<T: ?Sized>(value: &T) {
 mod tests {
     use super::*;
 
+    /// What a gather reads: single floats, rows of three of floats and
+    /// of `u32` bits, rows of four.
+    type Gathered = ([f32; 8], [[f32; 8]; 3], [[u32; 8]; 3], [[f32; 8]; 4]);
+
+    /// The bases of the four gathers: single floats, rows of three floats,
+    /// rows of three `u32`s, rows of four floats.
+    type Bases<'a> = (&'a [f32], &'a [f32], &'a [u32], &'a [[f32; 4]]);
+
     dispatch! {
-        /// The lanes' gathers of `index` from `f` and `u`.
-        fn gathered<>(f: &[f32], u: &[u32], index: [u32; 8]) -> ([f32; 8], [u32; 8]) => gathered_on
+        /// The lanes' four gathers, gather `k` of rows `index[k]`.
+        fn gathered<>(bases: Bases, index: [[u32; 8]; 4]) -> Gathered => gathered_on
     }
 
     #[inline(always)]
-    fn gathered_on<L: Lanes>(f: &[f32], u: &[u32], index: [u32; 8]) -> ([f32; 8], [u32; 8]) {
-        (L::gather(f, index).to_array(), L::gather_u32(u, index))
+    fn gathered_on<L: Lanes>((g, f, u, q): Bases, index: [[u32; 8]; 4]) -> Gathered {
+        let [x, y, z] = L::gather_xyz(f, 3, index[1]);
+        let [a, b, c, d] = L::gather_xyzw(q, index[3]);
+        (
+            L::gather(g, index[0]).to_array(),
+            [x.to_array(), y.to_array(), z.to_array()],
+            gather_xyz_u32::<L>(u, 3, index[2]),
+            [a.to_array(), b.to_array(), c.to_array(), d.to_array()],
+        )
     }
 
-    /// Gathers read `base[index]` per lane on both paths, and panic on an
-    /// index out of bounds, the last one and `u32::MAX` included.
+    /// Gathers read `base[index]` (and rows of it) per lane on both paths,
+    /// the last row of three included (which a whole-row load would read
+    /// past), every bit of a NaN kept, and each panics on an index out of
+    /// bounds, the first one past the end and `u32::MAX` included.
     #[test]
     fn gathers_read_their_indices_and_check_bounds() {
-        let f: Vec<f32> = (0..100).map(|i| i as f32 * 0.5).collect();
-        let u: Vec<u32> = (0..100).map(|i| i * 3).collect();
+        // A hundred rows in each base.
+        let g: Vec<f32> = (0..100).map(|i| i as f32 * 0.75).collect();
+        let f: Vec<f32> = (0..300).map(|i| i as f32 * 0.5).collect();
+        // Signalling and quiet NaNs, infinities, subnormals among the bits.
+        let u: Vec<u32> = (0..300)
+            .map(|i: u32| 0x7f80_0001_u32.wrapping_add(i.wrapping_mul(0x0101_0101)))
+            .collect();
+        let q: Vec<[f32; 4]> = (0..100)
+            .map(|i| [i as f32, -(i as f32), 0.25, i as f32 * 8.0])
+            .collect();
+        let bases = (&g[..], &f[..], &u[..], &q[..]);
+        for index in [
+            [0, 99, 5, 5, 17, 64, 1, 98],
+            [99; 8],
+            [3, 2, 1, 0, 99, 98, 97, 96],
+        ] {
+            let fields = |k: u32| index.map(|i| f[(3 * i + k) as usize]);
+            let bits = |k: u32| index.map(|i| u[(3 * i + k) as usize]);
+            let expected = (
+                index.map(|i| g[i as usize]),
+                [fields(0), fields(1), fields(2)],
+                [bits(0), bits(1), bits(2)],
+                [0, 1, 2, 3].map(|k| index.map(|i| q[i as usize][k])),
+            );
+            assert_eq!(gathered_on::<Portable>(bases, [index; 4]), expected);
+            assert_eq!(gathered(bases, [index; 4]), expected);
+        }
         let index = [0, 99, 5, 5, 17, 64, 1, 98];
-        let expected = (index.map(|i| f[i as usize]), index.map(|i| u[i as usize]));
-        assert_eq!(gathered_on::<Portable>(&f, &u, index), expected);
-        assert_eq!(gathered(&f, &u, index), expected);
         let mut checked = 0;
         for bad in [100, 101, u32::MAX, 1 << 31] {
             for lane in [0, 7] {
-                let mut index = index;
-                index[lane] = bad;
+                let mut wrong = index;
+                wrong[lane] = bad;
                 for path in [gathered_on::<Portable>, gathered] {
-                    let result = std::panic::catch_unwind(|| path(&f, &u, index));
-                    assert!(result.is_err(), "index {bad} in lane {lane} read");
-                    checked += 1;
+                    for which in 0..4 {
+                        let mut indices = [index; 4];
+                        indices[which] = wrong;
+                        let result = std::panic::catch_unwind(|| path(bases, indices));
+                        assert!(
+                            result.is_err(),
+                            "gather {which}: index {bad} in lane {lane} read"
+                        );
+                        checked += 1;
+                    }
                 }
             }
         }
-        assert_eq!(checked, 16);
+        assert_eq!(checked, 64);
     }
 }

@@ -16,7 +16,7 @@ use crate::edge::{EightVertices, ScreenVertex, Stored, Triangle2D, Triangle2DFix
 use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
-use crate::screen_boxes::{PixelRects, pixels_lanes, strided};
+use crate::screen_boxes::{PixelRects, pixels_lanes};
 use crate::simd::{self, EightIds, Lanes, finite, first_lanes};
 
 /// Every drawable triangle, clipped, projected and set up with f32 edge
@@ -233,7 +233,7 @@ fn screen_vertices(scene: &PreparedScene, view: &View, planes: &[ClipPlane]) -> 
 /// What [`kept_eight`] gathers from: the projected vertices and the
 /// triangles' vertex records, flat.
 struct LaneVertices<'a> {
-    points: &'a [f32],
+    points: &'a [[f32; 4]],
     records: &'a [u32],
     size: [u32; 2],
     span: SampleSpan,
@@ -255,7 +255,7 @@ impl<'a> LaneVertices<'a> {
             records.len()
         );
         LaneVertices {
-            points: points.as_flattened(),
+            points,
             records: records.as_flattened(),
             size,
             span,
@@ -279,15 +279,13 @@ fn kept_eight_on<L: Lanes>(lanes: &LaneVertices, ids: &[u32; 8], n: usize) -> Ke
     // Per vertex: x, y and a pad of zero (the bounds are the vertices').
     let mut points = [[zero; 3]; 3];
     let mut finite_xy = u8::MAX;
+    let vertices = simd::gather_xyz_u32::<L>(lanes.records, 3, *ids);
     for k in 0..3 {
-        let vertex = L::gather_u32(lanes.records, strided(*ids, 3, k as u32));
-        let x = L::gather(lanes.points, strided(vertex, 4, 0));
-        let y = L::gather(lanes.points, strided(vertex, 4, 1));
-        let q = L::gather(lanes.points, strided(vertex, 4, 2));
+        let [x, y, q, is_kept] = L::gather_xyzw(lanes.points, vertices[k]);
         (v[0][k], v[1][k], v[2][k]) = (x.to_array(), y.to_array(), q.to_array());
         points[k] = [x, y, zero];
         finite_xy &= finite(x) & finite(y);
-        kept &= L::gather(lanes.points, strided(vertex, 4, 3)).eq(L::splat(1.0));
+        kept &= is_kept.eq(L::splat(1.0));
     }
     KeptEight {
         vertices: v,

@@ -13,7 +13,7 @@ use crate::edge::{
 use crate::ground::PixelRect;
 use crate::ground::SampleSpan;
 use crate::prepared::PreparedScene;
-use crate::screen_boxes::{PixelRects, ScreenBoxes, rects_eight, strided};
+use crate::screen_boxes::{PixelRects, ScreenBoxes, rects_eight};
 use crate::simd::{self, EightIds, Lanes, first_lanes};
 
 /// Every drawable triangle with samples on screen, set up with 3D edge functions.
@@ -145,11 +145,7 @@ fn setup_3d_eight_on<L: Lanes>(
         // Past the end, the last record (`n ≥ 1`).
         Records::Run(first) => std::array::from_fn(|l| first + (l as u32).min(n as u32 - 1)),
     };
-    let vertices = [
-        L::gather_u32(mesh.records, strided(items, 3, 0)),
-        L::gather_u32(mesh.records, strided(items, 3, 1)),
-        L::gather_u32(mesh.records, strided(items, 3, 2)),
-    ];
+    let vertices = simd::gather_xyz_u32::<L>(mesh.records, 3, items);
     let (view, span) = (mesh.view, mesh.span);
     let rects =
         (mesh.boxes).rects_lanes::<L>(&vertices, first_lanes(n), mesh.positions, view, span);
@@ -161,25 +157,15 @@ fn setup_3d_eight_on<L: Lanes>(
     }
     let flat = bytemuck::cast_slice(mesh.positions);
     let corners = [
-        corner_lanes::<L>(flat, vertices[0]),
-        corner_lanes::<L>(flat, vertices[1]),
-        corner_lanes::<L>(flat, vertices[2]),
+        L::gather_xyz(flat, 3, vertices[0]),
+        L::gather_xyz(flat, 3, vertices[1]),
+        L::gather_xyz(flat, 3, vertices[2]),
     ];
     let corners_of = |l: usize| vertices.map(|v| mesh.positions[v[l] as usize]);
     (
         rects,
         Triangle3D::setup_lanes(&corners, present, view, corners_of),
     )
-}
-
-/// The positions of vertices `v`, one per lane, per axis.
-#[inline(always)]
-fn corner_lanes<L: Lanes>(flat: &[f32], v: [u32; 8]) -> [L; 3] {
-    [
-        L::gather(flat, strided(v, 3, 0)),
-        L::gather(flat, strided(v, 3, 1)),
-        L::gather(flat, strided(v, 3, 2)),
-    ]
 }
 
 /// What the view's [`Triangle3D`]s share, set up by the 3D setup or the
