@@ -331,7 +331,13 @@ mod avx2_lanes {
             // has a fourth float after its three (all but a last row of
             // three): a load a row beats a gather a field.
             if !all_below(offsets, base.len().saturating_sub(3)) {
-                return [0, 1, 2].map(|k| Self::gather(base, offsets.map(|o| o.wrapping_add(k))));
+                // Field by field (no closure around a lane operation: it
+                // would be compiled without AVX2).
+                return [
+                    Self::gather(base, offsets),
+                    Self::gather(base, offsets.map(|o| o.wrapping_add(1))),
+                    Self::gather(base, offsets.map(|o| o.wrapping_add(2))),
+                ];
             }
             // SAFETY: every offset `o` is below `base.len() − 3`, so the
             // four floats from `o` lie in `base`.
