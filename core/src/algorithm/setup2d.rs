@@ -230,8 +230,8 @@ fn screen_vertices(scene: &PreparedScene, view: &View, planes: &[ClipPlane]) -> 
         .collect()
 }
 
-/// What [`kept_eight`] gathers from: the projected vertices and the
-/// triangles' vertex records, flat.
+/// What [`kept_eight`] gathers from: the projected vertices (x, y, q and
+/// kept, a row each) and the triangles' vertex records, flat.
 struct LaneVertices<'a> {
     points: &'a [[f32; 4]],
     records: &'a [u32],
