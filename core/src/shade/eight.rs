@@ -15,7 +15,7 @@
 use glam::{Vec3, Vec4};
 
 use super::{AMBIENT, LightFrom, Shader};
-use crate::simd::{Lanes, finite};
+use crate::simd::{self, Lanes, finite};
 
 /// Three lanes of f32: eight vectors.
 #[derive(Clone, Copy)]
@@ -32,16 +32,6 @@ impl<L: Lanes> V3<L> {
             x: L::splat(v.x),
             y: L::splat(v.y),
             z: L::splat(v.z),
-        }
-    }
-
-    /// `v` in the lanes of `lanes`, `self` in the others.
-    #[inline(always)]
-    fn blend(self, lanes: u8, v: Vec3) -> Self {
-        V3 {
-            x: L::select(lanes, L::splat(v.x), self.x),
-            y: L::select(lanes, L::splat(v.y), self.y),
-            z: L::select(lanes, L::splat(v.z), self.z),
         }
     }
 
@@ -84,6 +74,13 @@ impl<L: Lanes> V3<L> {
             y: self.z * o.x - o.z * self.x,
             z: self.x * o.y - o.x * self.y,
         }
+    }
+
+    /// Fields 0–2 of the rows `index` of `flat` (rows of three floats).
+    #[inline(always)]
+    fn gathered(flat: &[f32], index: [u32; 8]) -> Self {
+        let [x, y, z] = L::gather_xyz(flat, 3, index);
+        V3 { x, y, z }
     }
 
     /// glam's `normalize_or`: `self · (1 / |self|)`, and the lanes where
@@ -166,67 +163,66 @@ impl Shader<'_> {
         debug_assert!(s.lanes != 0, "at least one lane to shade");
         let mut done = s.lanes;
         // 1. What each lane's triangle brings (lanes without one take the
-        // first that has one, so that every lane computes on real values).
-        // Neighbouring samples mostly hold one triangle: each run of lanes
-        // holding one has its records read once, and broadcast into its
-        // lanes (not stored lane by lane and read back whole, which waits
-        // for the stores to land).
+        // first that has one, so that every lane computes on real values),
+        // read in lanes: each lane's vertex record, then its three corners
+        // and normals, a row load each ([`Ops::gather_xyz`]) — no branch on
+        // how many triangles the eight holds, so the reads of every lane are
+        // on their way at once.
         let first = s.ids[done.trailing_zeros() as usize];
-        let mut ids = [first; 8];
-        let mut starts = 1u8;
-        for l in 0..8 {
-            if done & (1 << l) != 0 {
-                ids[l] = s.ids[l];
-            }
-            if l > 0 && ids[l] != ids[l - 1] {
-                starts |= 1 << l;
+        let ids: [u32; 8] = std::array::from_fn(|l| match done & (1 << l) {
+            0 => first,
+            _ => s.ids[l],
+        });
+        let vertices = simd::gather_xyz_u32::<L>(mesh.triangles.as_flattened(), 3, ids);
+        let (positions, normals_flat) = (
+            bytemuck::cast_slice(&mesh.positions),
+            bytemuck::cast_slice(&mesh.normals),
+        );
+        // (No closure around a lane operation: it would be compiled without
+        // the lanes' instruction set.)
+        let [a, b, c] = vertices;
+        let [p0, p1, p2] = [
+            V3::gathered(positions, a),
+            V3::gathered(positions, b),
+            V3::gathered(positions, c),
+        ];
+        let mut normals = [V3::<L>::splat(Vec3::ZERO); 3];
+        if interpolated {
+            normals = [
+                V3::gathered(normals_flat, a),
+                V3::gathered(normals_flat, b),
+                V3::gathered(normals_flat, c),
+            ];
+            // The scalar path's case (a zero vertex normal): these lanes go there.
+            let zero = L::splat(0.0);
+            for n in normals {
+                done &= !(n.x.eq(zero) & n.y.eq(zero) & n.z.eq(zero));
             }
         }
-        let zero = V3::splat(Vec3::ZERO);
-        let (mut p, mut normals) = ([zero; 3], [zero; 3]);
-        let materials = &prepared.scene.materials;
-        let one_material = materials.len() == 1;
-        let (mut base, mut emissive) = match one_material {
-            true => (
-                V3::splat(Vec4::from(materials[0].base_color).truncate()),
-                V3::splat(Vec3::from(materials[0].emissive)),
-            ),
-            false => (zero, zero),
+        let (base, emissive) = match &self.material_rows[..] {
+            [] => {
+                let material = &prepared.scene.materials[0];
+                (
+                    V3::splat(Vec4::from(material.base_color).truncate()),
+                    V3::splat(Vec3::from(material.emissive)),
+                )
+            }
+            rows => {
+                let of = L::gather(bytemuck::cast_slice(&mesh.material_ids), ids);
+                let of = bytemuck::cast(of.to_array());
+                let flat = rows.as_flattened();
+                let [x, y, z] = L::gather_xyz(flat, 8, of);
+                let [ex, ey, ez] = L::gather_xyz(&flat[4..], 8, of);
+                (
+                    V3 { x, y, z },
+                    V3 {
+                        x: ex,
+                        y: ey,
+                        z: ez,
+                    },
+                )
+            }
         };
-        let mut rest = starts;
-        while rest != 0 {
-            let l = rest.trailing_zeros();
-            rest &= rest - 1;
-            let end = if rest == 0 { 8 } else { rest.trailing_zeros() };
-            let lanes = ((1u16 << end) - (1u16 << l)) as u8;
-            let id = ids[l as usize];
-            // From the mesh: two dependent reads (vertex indices, then
-            // positions and normals side by side), where the slot-ordered
-            // copies take three (slot, copies, normals): a 1080p frame of
-            // teapots or the dragon 1–3 ms shorter.
-            let vertices = mesh.triangles[id as usize];
-            for k in 0..3 {
-                p[k] = p[k].blend(lanes, mesh.positions[vertices[k] as usize]);
-            }
-            if !one_material {
-                let material = &materials[self.material_of(id) as usize];
-                base = base.blend(lanes, Vec4::from(material.base_color).truncate());
-                emissive = emissive.blend(lanes, Vec3::from(material.emissive));
-            }
-            if interpolated {
-                let mut zero_normal = false;
-                for k in 0..3 {
-                    let n = mesh.normals[vertices[k] as usize];
-                    zero_normal |= n == Vec3::ZERO;
-                    normals[k] = normals[k].blend(lanes, n);
-                }
-                // The scalar path's case: these lanes go there.
-                if zero_normal {
-                    done &= !lanes;
-                }
-            }
-        }
-        let [p0, p1, p2] = p;
 
         // 2. The ray through each sample (`View::origin`, `View::direction`).
         let view = self.view;

@@ -57,6 +57,9 @@ pub struct Shader<'a> {
     /// Per material: are its samples shaded by [`Shader::shade_eight`]
     /// (a planar view, no texture, vertex colours, mirror or shadow ray)?
     lane_materials: Vec<bool>,
+    /// Per material when there are several, for [`Shader::shade_eight`]:
+    /// its base colour and emission as one row, `[r, g, b, 0, r, g, b, 0]`.
+    material_rows: Vec<[f32; 8]>,
     /// Every material's samples are shaded in lanes (`lane_materials` all
     /// true and not empty): no per-sample material read decides it.
     all_in_lanes: bool,
@@ -82,7 +85,12 @@ impl<'a> Shader<'a> {
             })
             .collect::<Vec<_>>();
         let mesh = &scene.scene.mesh;
+        // Lanes find vertices and materials by 32-bit offsets.
+        let fits = |n: usize| n < (i32::MAX / 8) as usize;
         let lanes_fit = view.sphere.is_none()
+            && fits(mesh.positions.len())
+            && fits(mesh.triangles.len())
+            && fits(scene.scene.materials.len())
             && plan.shadow_lights.is_empty()
             && mesh.colors.is_empty()
             && light_terms.iter().all(|(_, color)| color.is_finite());
@@ -92,6 +100,16 @@ impl<'a> Shader<'a> {
                 .map(|m| {
                     (m.base_color_texture.is_none() || mesh.uvs.is_empty())
                         && m.reflectivity.clamp(0.0, 1.0) == 0.0
+                })
+                .collect(),
+        };
+        let material_rows = match scene.scene.materials.len() {
+            1 => Vec::new(),
+            _ => (scene.scene.materials.iter())
+                .map(|m| {
+                    let [r, g, b, _] = m.base_color;
+                    let [er, eg, eb] = m.emissive;
+                    [r, g, b, 0.0, er, eg, eb, 0.0]
                 })
                 .collect(),
         };
@@ -106,6 +124,7 @@ impl<'a> Shader<'a> {
             rays: Rays::new(scene),
             t_min: scene.bounds.radius().max(f32::MIN_POSITIVE) * SECONDARY_OFFSET,
             lane_materials,
+            material_rows,
             all_in_lanes,
         }
     }
