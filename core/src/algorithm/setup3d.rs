@@ -50,7 +50,11 @@ pub(crate) fn setup_slots_3d<'a>(
     set_up_in_lanes(&lanes, &scene.slot_triangles, true, shared)
 }
 
-/// The triangles `ids` set up in lanes ([`setup_3d_eight`]), eight at a
+/// Triangles per block of the setup in lanes ([`setup_3d_block`]): eight
+/// eights, whose lanes with a box are packed into as few setups as they fill.
+const BLOCK: usize = 64;
+
+/// The triangles `ids` set up in lanes ([`setup_3d_block`]), a block at a
 /// time: `mesh`'s records by id, or (`by_slot`) the records in a row, one
 /// per item (the BVH's slots, whose triangles `ids` lists).
 fn set_up_in_lanes<'a>(
@@ -59,17 +63,11 @@ fn set_up_in_lanes<'a>(
     by_slot: bool,
     shared: Shared3D<'a>,
 ) -> Setups<'a, Triangle3D> {
-    let eights = ids.par_chunks(8).enumerate().map(|(chunk, eight)| {
-        let (rects, triangles) = match by_slot {
-            true => setup_3d_eight(mesh, Records::Run((chunk * 8) as u32), eight.len()),
-            false => {
-                let listed = EightIds::of(eight);
-                setup_3d_eight(mesh, Records::Listed(listed.get()), eight.len())
-            }
-        };
-        paired(|l| rects.get(l), lanes_of(eight), triangles)
+    let blocks = ids.par_chunks(BLOCK).enumerate().map(|(block, ids)| {
+        let run = by_slot.then_some((block * BLOCK) as u32);
+        setup_3d_block(mesh, ids, run)
     });
-    flattened(eights.unzip(), ids.len(), shared)
+    flattened(blocks.unzip(), ids.len(), shared)
 }
 
 /// What a perspective setup in lanes ([`setup_3d_eight`]) reads: the mesh's
@@ -112,7 +110,7 @@ impl<'a> LaneMesh<'a> {
     }
 }
 
-/// Which vertex records eight lanes set up.
+/// Which vertex records eight lanes read.
 #[derive(Clone, Copy, Debug)]
 enum Records<'a> {
     /// These (lanes past the chunk's end repeat its last one).
@@ -121,40 +119,98 @@ enum Records<'a> {
     Run(u32),
 }
 
+impl Records<'_> {
+    /// The record of each lane, the first `n` (at least one) of them
+    /// (the last one repeated past them).
+    #[inline(always)]
+    fn items(self, n: usize) -> [u32; 8] {
+        match self {
+            Records::Listed(items) => *items,
+            Records::Run(first) => std::array::from_fn(|l| first + (l as u32).min(n as u32 - 1)),
+        }
+    }
+}
+
+/// A block's set-up triangles: per item, its box and triangle id (or
+/// [`ItemBox::NONE`]) and its setup (or `None`).
+type Block = ([ItemBox; BLOCK], [Option<Triangle3D>; BLOCK]);
+
 simd::dispatch! {
-    /// The screen boxes and 3D setups of the first `n` (at least one) of
-    /// eight triangles with vertex records `records`, each exactly as
-    /// [`ScreenBoxes::rect`] and [`Triangle3D::setup_eight`] make them:
-    /// vertex indices, projected points and corners gathered straight into
-    /// lanes, with no per-lane copies between the steps.
-    fn setup_3d_eight<>(
-        mesh: &LaneMesh,
-        records: Records,
-        n: usize,
-    ) -> (PixelRects, [Option<Triangle3D>; 8]) => setup_3d_eight_on
+    /// The screen boxes and 3D setups of the items `ids` (at most
+    /// [`BLOCK`], triangle ids), each exactly as [`ScreenBoxes::rect`] and
+    /// [`Triangle3D::setup_eight`] make them: the records are `ids`
+    /// themselves, or (`run`) the ones in a row from `run`. Boxes come
+    /// eight at a time; then only the items with one are set up, packed
+    /// eight to a setup — a mesh of sub-pixel triangles (most of whose
+    /// boxes hold no sample) sets up each triangle with samples once, not
+    /// every eight that holds one.
+    fn setup_3d_block<>(mesh: &LaneMesh, ids: &[u32], run: Option<u32>) -> Block => setup_3d_block_on
 }
 
 #[inline(always)]
-fn setup_3d_eight_on<L: Lanes>(
-    mesh: &LaneMesh,
-    records: Records,
-    n: usize,
-) -> (PixelRects, [Option<Triangle3D>; 8]) {
-    let items = match records {
-        Records::Listed(items) => *items,
-        // Past the end, the last record (`n ≥ 1`).
-        Records::Run(first) => std::array::from_fn(|l| first + (l as u32).min(n as u32 - 1)),
-    };
-    let vertices = simd::gather_xyz_u32::<L>(mesh.records, 3, items);
-    let (view, span) = (mesh.view, mesh.span);
-    let rects =
-        (mesh.boxes).rects_lanes::<L>(&vertices, first_lanes(n), mesh.positions, view, span);
-    let present = rects.some;
-    // Off-screen triangles come in runs (the mesh's order is spatial):
-    // eight at once with no box skip the setup.
-    if present == 0 {
-        return (rects, [None; 8]);
+fn setup_3d_block_on<L: Lanes>(mesh: &LaneMesh, ids: &[u32], run: Option<u32>) -> Block {
+    debug_assert!(!ids.is_empty() && ids.len() <= BLOCK);
+    let (mut boxes, mut triangles) = ([ItemBox::NONE; BLOCK], [None; BLOCK]);
+    // The items with a box not yet set up: their records, and where they are.
+    let (mut packed, mut at, mut n) = ([0u32; 8], [0usize; 8], 0);
+    for (e, eight) in ids.chunks(8).enumerate() {
+        let listed = EightIds::of(eight);
+        let records = match run {
+            Some(first) => Records::Run(first + (e * 8) as u32),
+            None => Records::Listed(listed.get()),
+        };
+        let items = records.items(eight.len());
+        let rects = rects_eight_lanes::<L>(mesh, items, eight.len());
+        let mut some = rects.some;
+        while some != 0 {
+            let l = some.trailing_zeros() as usize;
+            some &= some - 1;
+            let rect = rects.get(l).expect("a lane of `some` has a rect");
+            boxes[e * 8 + l] = ItemBox::new(rect, eight[l]);
+            (packed[n], at[n]) = (items[l], e * 8 + l);
+            n += 1;
+            if n == 8 {
+                set_up_packed::<L>(mesh, &packed, &at, 8, (&mut boxes, &mut triangles));
+                n = 0;
+            }
+        }
     }
+    if n > 0 {
+        for l in n..8 {
+            packed[l] = packed[n - 1];
+        }
+        set_up_packed::<L>(mesh, &packed, &at, n, (&mut boxes, &mut triangles));
+    }
+    (boxes, triangles)
+}
+
+/// The boxes of the first `n` (at least one) of the eight triangles with
+/// records `items` ([`ScreenBoxes::rects_lanes`]).
+#[inline(always)]
+fn rects_eight_lanes<L: Lanes>(mesh: &LaneMesh, items: [u32; 8], n: usize) -> PixelRects {
+    let vertices = simd::gather_xyz_u32::<L>(mesh.records, 3, items);
+    (mesh.boxes).rects_lanes::<L>(
+        &vertices,
+        first_lanes(n),
+        mesh.positions,
+        mesh.view,
+        mesh.span,
+    )
+}
+
+/// The first `n` of the eight triangles with records `items` (the last one
+/// repeated past them), each with a box, set up in lanes
+/// ([`Triangle3D::setup_lanes`]) into item `at[l]` of the block; an item
+/// whose setup is `None` loses its box.
+#[inline(always)]
+fn set_up_packed<L: Lanes>(
+    mesh: &LaneMesh,
+    items: &[u32; 8],
+    at: &[usize; 8],
+    n: usize,
+    (boxes, triangles): (&mut [ItemBox; BLOCK], &mut [Option<Triangle3D>; BLOCK]),
+) {
+    let vertices = simd::gather_xyz_u32::<L>(mesh.records, 3, *items);
     let flat = bytemuck::cast_slice(mesh.positions);
     let corners = [
         L::gather_xyz(flat, 3, vertices[0]),
@@ -162,10 +218,13 @@ fn setup_3d_eight_on<L: Lanes>(
         L::gather_xyz(flat, 3, vertices[2]),
     ];
     let corners_of = |l: usize| vertices.map(|v| mesh.positions[v[l] as usize]);
-    (
-        rects,
-        Triangle3D::setup_lanes(&corners, present, view, corners_of),
-    )
+    let set_up = Triangle3D::setup_lanes(&corners, first_lanes(n), mesh.view, corners_of);
+    for l in 0..n {
+        match set_up[l] {
+            Some(triangle) => triangles[at[l]] = Some(triangle),
+            None => boxes[at[l]] = ItemBox::NONE,
+        }
+    }
 }
 
 /// What the view's [`Triangle3D`]s share, set up by the 3D setup or the
@@ -287,9 +346,9 @@ fn paired<T>(
     (boxes, triangles)
 }
 
-/// The first `len` items of chunks of eight, sharing `shared`.
-fn flattened<'a, T: Stored>(
-    (boxes, triangles): (Vec<[ItemBox; 8]>, Vec<[Option<T>; 8]>),
+/// The first `len` items of chunks of `N`, sharing `shared`.
+fn flattened<'a, T: Stored, const N: usize>(
+    (boxes, triangles): (Vec<[ItemBox; N]>, Vec<[Option<T>; N]>),
     len: usize,
     shared: T::Shared<'a>,
 ) -> Setups<'a, T> {
@@ -369,18 +428,19 @@ mod tests {
     use crate::aa::{AaMode, SamplePattern};
     use crate::{Camera, Viewport};
 
-    type Kernel = fn(&LaneMesh, Records, usize) -> (PixelRects, [Option<Triangle3D>; 8]);
+    type Kernel = fn(&LaneMesh, &[u32], Option<u32>) -> Block;
 
-    /// `kernel` gives every lane the box [`ScreenBoxes::rect`] gives and the
+    /// `kernel` gives every item the box [`ScreenBoxes::rect`] gives and the
     /// set-up triangle the eight-at-a-time path gives
     /// ([`Triangle3D::setup_eight`], checked against the one-triangle form),
-    /// bit for bit: random meshes of shared vertices on screen, off it,
-    /// across the near plane and behind the eye; listed and run records;
-    /// full and short chunks.
+    /// bit for bit, whichever other items of its block have a box (which
+    /// decides the lanes it is set up in): random meshes of shared vertices
+    /// on screen, off it, across the near plane and behind the eye; listed
+    /// and run records; full and short blocks.
     fn lanes_match_the_eight_path(kernel: Kernel) {
         let mut rng = fastrand::Rng::with_seed(31);
-        let (mut checked, mut set_up, mut scalar_boxes) = (0, 0, 0);
-        for case in 0..600 {
+        let (mut checked, mut set_up, mut scalar_boxes, mut packed) = (0, 0, 0, 0);
+        for case in 0..300 {
             let eye = Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 4.0;
             let camera = Camera {
                 name: "test".into(),
@@ -401,64 +461,78 @@ mod tests {
                     eye + d * scale
                 })
                 .collect();
-            let records: Vec<[u32; 3]> = (0..64)
+            let records: Vec<[u32; 3]> = (0..2 * BLOCK)
                 .map(|_| [rng.u32(0..40), rng.u32(0..40), rng.u32(0..40)])
                 .collect();
             let span = SamplePattern::of([AaMode::None, AaMode::Ssaa(16)][case % 2]).span;
             let boxes = ScreenBoxes::of(&positions, &view);
             let mesh = LaneMesh::new(&boxes, &positions, &records, &view, span);
-            let n = rng.usize(1..=8);
-            let mut listed: [u32; 8] = std::array::from_fn(|_| rng.u32(0..64));
-            for l in n..8 {
-                listed[l] = listed[n - 1];
-            }
-            let first = rng.u32(0..=56);
-            let run = std::array::from_fn(|l| first + l.min(n - 1) as u32);
-            for (records_of, items) in [
-                (Records::Listed(&listed), listed),
-                (Records::Run(first), run),
-            ] {
-                let (rects, triangles) = kernel(&mesh, records_of, n);
-                let corners: [[Vec3; 3]; 8] =
-                    items.map(|i| records[i as usize].map(|v| positions[v as usize]));
-                let vertices = items.map(|i| records[i as usize]);
-                let expected_rects: [_; 8] = std::array::from_fn(|l| {
-                    (l < n)
-                        .then(|| boxes.rect(&corners[l], vertices[l], &view, span))
-                        .flatten()
-                });
-                let eight = EightTriangles {
-                    corners: std::array::from_fn(|l| &corners[l]),
-                    vertices,
-                    present: (0..8).fold(0, |m, l| m | u8::from(expected_rects[l].is_some()) << l),
-                };
-                let expected = Triangle3D::setup_eight(&eight, &view);
-                for l in 0..8 {
-                    let at = format!("case {case}, lane {l} of {n}");
-                    assert_eq!(rects.get(l), expected_rects[l], "{at}");
-                    // Debug shows the sign of a zero, which `==` does not.
-                    assert_eq!(
-                        format!("{:?}", triangles[l]),
-                        format!("{:?}", expected[l]),
-                        "{at}"
-                    );
-                    checked += usize::from(l < n);
-                    set_up += usize::from(l < n && triangles[l].is_some());
-                    let projected =
-                        (0..3).all(|k| boxes.points[vertices[l][k] as usize][0].is_finite());
-                    scalar_boxes += usize::from(l < n && !projected);
+            let n = [rng.usize(1..=BLOCK), BLOCK][case % 2];
+            let bound = 2 * BLOCK as u32;
+            let listed: Vec<u32> = (0..n).map(|_| rng.u32(0..bound)).collect();
+            let first = rng.u32(0..=BLOCK as u32);
+            let run: Vec<u32> = (0..n as u32).map(|k| first + k).collect();
+            for (ids, run_from, items) in [(&listed, None, &listed), (&run, Some(first), &run)] {
+                let (got_boxes, got) = kernel(&mesh, ids, run_from);
+                let corners: Vec<[Vec3; 3]> = (items.iter())
+                    .map(|&i| records[i as usize].map(|v| positions[v as usize]))
+                    .collect();
+                let rects: Vec<_> = (0..n)
+                    .map(|k| boxes.rect(&corners[k], records[items[k] as usize], &view, span))
+                    .collect();
+                let mut with_box = 0;
+                for e in 0..n.div_ceil(8) {
+                    let lane = |l: usize| (e * 8 + l).min(n - 1);
+                    let eight = EightTriangles {
+                        corners: std::array::from_fn(|l| &corners[lane(l)]),
+                        vertices: std::array::from_fn(|l| records[items[lane(l)] as usize]),
+                        present: (0..8).fold(0, |m, l| {
+                            m | u8::from(e * 8 + l < n && rects[lane(l)].is_some()) << l
+                        }),
+                    };
+                    with_box += eight.present.count_ones();
+                    let expected = Triangle3D::setup_eight(&eight, &view);
+                    for l in 0..8 {
+                        let k = e * 8 + l;
+                        let at = format!("case {case}, item {k} of {n}");
+                        let Some(&tri) = expected.get(l).filter(|_| k < n) else {
+                            continue;
+                        };
+                        let expected_box = match (rects[k], tri) {
+                            (Some(rect), Some(_)) => ItemBox::new(rect, ids[k]),
+                            _ => ItemBox::NONE,
+                        };
+                        assert_eq!(got_boxes[k], expected_box, "{at}");
+                        let tri = tri.filter(|_| rects[k].is_some());
+                        // Debug shows the sign of a zero, which `==` does not.
+                        assert_eq!(format!("{:?}", got[k]), format!("{tri:?}"), "{at}");
+                        checked += 1;
+                        set_up += usize::from(tri.is_some());
+                        let projected = (0..3).all(|v| {
+                            boxes.points[records[items[k] as usize][v] as usize][0].is_finite()
+                        });
+                        scalar_boxes += usize::from(!projected);
+                    }
                 }
+                assert!(got_boxes[n..].iter().all(|b| *b == ItemBox::NONE));
+                assert!(got[n..].iter().all(Option::is_none));
+                // An item with a box after one without: set up in a lane
+                // other than its own.
+                let first_gap = rects.iter().position(Option::is_none).unwrap_or(n);
+                packed += usize::from(rects[first_gap..].iter().any(Option::is_some));
+                assert!(with_box as usize <= n);
             }
         }
         assert!(
-            checked > 4_000 && set_up > 1_000 && scalar_boxes > 500,
-            "{checked} lanes checked, {set_up} set up, {scalar_boxes} boxed by the scalar path"
+            checked > 10_000 && set_up > 1_000 && scalar_boxes > 500 && packed > 100,
+            "{checked} items checked, {set_up} set up, {scalar_boxes} boxed by the scalar \
+             path, {packed} blocks packed"
         );
     }
 
     #[test]
     fn portable_lanes_set_up_as_eight_at_a_time() {
-        lanes_match_the_eight_path(setup_3d_eight_on::<simd::Portable>);
+        lanes_match_the_eight_path(setup_3d_block_on::<simd::Portable>);
     }
 
     #[test]
@@ -468,7 +542,7 @@ mod tests {
             simd::cpu_has_avx2(),
             "this test checks the AVX2 kernel, and this CPU has no AVX2"
         );
-        // `setup_3d_eight` takes AVX2 where the CPU has it.
-        lanes_match_the_eight_path(setup_3d_eight);
+        // `setup_3d_block` takes AVX2 where the CPU has it.
+        lanes_match_the_eight_path(setup_3d_block);
     }
 }
