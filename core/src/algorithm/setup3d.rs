@@ -33,8 +33,8 @@ pub(crate) fn setup_3d<'a>(
 }
 
 /// [`setup_slots`] of [`Triangle3D`]s: every BVH slot's triangle set up
-/// with 3D edge functions, eight slots at a time in lanes where the view
-/// allows ([`setup_3d_eight`]).
+/// with 3D edge functions, in lanes a block of slots at a time where the
+/// view allows ([`setup_3d_block`]).
 pub(crate) fn setup_slots_3d<'a>(
     scene: &'a PreparedScene,
     view: &'a View,
@@ -70,7 +70,7 @@ fn set_up_in_lanes<'a>(
     flattened(blocks.unzip(), ids.len(), shared)
 }
 
-/// What a perspective setup in lanes ([`setup_3d_eight`]) reads: the mesh's
+/// What a perspective setup in lanes ([`setup_3d_block`]) reads: the mesh's
 /// positions and vertex records (`[u32; 3]` per triangle) as flat arrays
 /// the lanes gather from, the vertices' projections, the view.
 struct LaneMesh<'a> {
