@@ -110,27 +110,6 @@ impl<'a> LaneMesh<'a> {
     }
 }
 
-/// Which vertex records eight lanes read.
-#[derive(Clone, Copy, Debug)]
-enum Records<'a> {
-    /// These (lanes past the chunk's end repeat its last one).
-    Listed(&'a [u32; 8]),
-    /// Eight in a row from this one.
-    Run(u32),
-}
-
-impl Records<'_> {
-    /// The record of each lane, the first `n` (at least one) of them
-    /// (the last one repeated past them).
-    #[inline(always)]
-    fn items(self, n: usize) -> [u32; 8] {
-        match self {
-            Records::Listed(items) => *items,
-            Records::Run(first) => std::array::from_fn(|l| first + (l as u32).min(n as u32 - 1)),
-        }
-    }
-}
-
 /// A block's set-up triangles: per item, its box and triangle id (or
 /// [`ItemBox::NONE`]) and its setup (or `None`).
 type Block = ([ItemBox; BLOCK], [Option<Triangle3D>; BLOCK]);
@@ -154,12 +133,14 @@ fn setup_3d_block_on<L: Lanes>(mesh: &LaneMesh, ids: &[u32], run: Option<u32>) -
     // The items with a box not yet set up: their records, and where they are.
     let (mut packed, mut at, mut n) = ([0u32; 8], [0usize; 8], 0);
     for (e, eight) in ids.chunks(8).enumerate() {
-        let listed = EightIds::of(eight);
-        let records = match run {
-            Some(first) => Records::Run(first + (e * 8) as u32),
-            None => Records::Listed(listed.get()),
+        // Each lane's record (past the chunk's end, its last one).
+        let items = match run {
+            Some(first) => {
+                let last = eight.len() - 1;
+                std::array::from_fn(|l| first + (e * 8 + l.min(last)) as u32)
+            }
+            None => *EightIds::of(eight).get(),
         };
-        let items = records.items(eight.len());
         let rects = rects_eight_lanes::<L>(mesh, items, eight.len());
         let mut some = rects.some;
         while some != 0 {

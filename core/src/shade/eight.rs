@@ -76,10 +76,10 @@ impl<L: Lanes> V3<L> {
         }
     }
 
-    /// Fields 0–2 of the rows `index` of `flat` (rows of three floats).
+    /// Fields 0–2 of the rows `index` of `flat` (rows of `stride` floats).
     #[inline(always)]
-    fn gathered(flat: &[f32], index: [u32; 8]) -> Self {
-        let [x, y, z] = L::gather_xyz(flat, 3, index);
+    fn gathered(flat: &[f32], stride: u32, index: [u32; 8]) -> Self {
+        let [x, y, z] = L::gather_xyz(flat, stride, index);
         V3 { x, y, z }
     }
 
@@ -182,16 +182,16 @@ impl Shader<'_> {
         // the lanes' instruction set.)
         let [a, b, c] = vertices;
         let [p0, p1, p2] = [
-            V3::gathered(positions, a),
-            V3::gathered(positions, b),
-            V3::gathered(positions, c),
+            V3::gathered(positions, 3, a),
+            V3::gathered(positions, 3, b),
+            V3::gathered(positions, 3, c),
         ];
         let mut normals = [V3::<L>::splat(Vec3::ZERO); 3];
         if interpolated {
             normals = [
-                V3::gathered(normals_flat, a),
-                V3::gathered(normals_flat, b),
-                V3::gathered(normals_flat, c),
+                V3::gathered(normals_flat, 3, a),
+                V3::gathered(normals_flat, 3, b),
+                V3::gathered(normals_flat, 3, c),
             ];
             // The scalar path's case (a zero vertex normal): these lanes go there.
             let zero = L::splat(0.0);
@@ -199,7 +199,7 @@ impl Shader<'_> {
                 done &= !(n.x.eq(zero) & n.y.eq(zero) & n.z.eq(zero));
             }
         }
-        let (base, emissive) = match &self.material_rows[..] {
+        let (base, emissive): (V3<L>, V3<L>) = match &self.material_rows[..] {
             [] => {
                 let material = &prepared.scene.materials[0];
                 (
@@ -211,16 +211,7 @@ impl Shader<'_> {
                 let of = L::gather(bytemuck::cast_slice(&mesh.material_ids), ids);
                 let of = bytemuck::cast(of.to_array());
                 let flat = rows.as_flattened();
-                let [x, y, z] = L::gather_xyz(flat, 8, of);
-                let [ex, ey, ez] = L::gather_xyz(&flat[4..], 8, of);
-                (
-                    V3 { x, y, z },
-                    V3 {
-                        x: ex,
-                        y: ey,
-                        z: ez,
-                    },
-                )
+                (V3::gathered(flat, 8, of), V3::gathered(&flat[4..], 8, of))
             }
         };
 
