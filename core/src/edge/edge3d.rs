@@ -300,15 +300,15 @@ fn scaled_down(c: [Vec3; 3], max: f32) -> ([Vec3; 3], f32) {
     (c.map(|v| v * down), 2f32.powi(k))
 }
 
-/// Whether every value is finite, without a branch per value: zero times a
-/// finite value is ±0, times ±∞ or NaN it is NaN, and NaN stays in a sum.
+/// Whether every value is finite, without a branch per value: a value is
+/// finite when its magnitude's bits are below infinity's, so the largest
+/// magnitude decides (an integer maximum, unrolled over the fixed count: a
+/// running float sum of `v · 0` was a chain of dependent adds).
 #[inline(always)]
-fn all_finite(values: &[[f32; 3]]) -> bool {
-    let mut nan = 0.0f32;
-    for v in values.iter().flatten() {
-        nan += v * 0.0;
-    }
-    nan == 0.0
+fn all_finite<const N: usize>(values: &[[f32; 3]; N]) -> bool {
+    let largest =
+        (values.as_flattened().iter()).fold(0, |m: u32, v| m.max(v.to_bits() & 0x7fff_ffff));
+    largest < f32::INFINITY.to_bits()
 }
 
 /// Linear functions of the image point, `k[0] + x·k[1] + y·k[2]`.
