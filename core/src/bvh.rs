@@ -186,10 +186,10 @@ impl SceneBvh {
     /// meet it before its own culling distance, so every ray reaches every
     /// node its single walk would (front to back in the first present ray's
     /// order). The groups share each node's read and decode, and are tested
-    /// each on its own: rays from one origin (every perspective and
-    /// spherical view) by the group's [`PacketInterval`] against its own
-    /// largest culling distance, one 8-lane test per node and group; others
-    /// ray by ray. So a packet whose groups diverge (one done behind a near
+    /// each on its own, by the group's [`PacketInterval`] (over one origin in
+    /// perspective and spherical views, over the origins' range in
+    /// orthographic ones) against its own largest culling distance: one
+    /// 8-lane test per node and group. So a packet whose groups diverge (one done behind a near
     /// surface, another still open to the background) culls as its groups
     /// would alone. `leaf(slot, cull)` is called for each primitive slot of
     /// every leaf the packet reaches, updates each lane's culling distance in
@@ -210,42 +210,48 @@ impl SceneBvh {
         }
         // Loops, not `map` closures: this is lane code (see `crate::simd`).
         // Absent lanes never enter a node.
-        let mut slabs = [[None; PACKET]; G];
         let mut cull = [[f32::NEG_INFINITY; PACKET]; G];
         let mut intervals = [None; G];
         let mut first = None;
         for g in 0..G {
-            match rays[g] {
+            let (interval, present, direction) = match rays[g] {
                 PacketRays::OneOrigin {
                     origin,
                     directions,
                     present,
-                } => {
-                    if present == 0 {
-                        continue;
-                    }
-                    for (l, c) in cull[g].iter_mut().enumerate() {
-                        if present >> l & 1 == 1 {
-                            *c = f32::INFINITY;
-                        }
-                    }
-                    let l = present.trailing_zeros() as usize;
-                    let d = Vec3::new(directions[0][l], directions[1][l], directions[2][l]);
-                    first = first.or(Some(d));
-                    let interval = PacketInterval::of_directions::<L>(origin, &directions, present);
-                    intervals[g] = Some(interval);
-                }
+                } if present != 0 => (
+                    PacketInterval::of_directions::<L>(origin, &directions, present),
+                    present,
+                    lane_vector(&directions, present.trailing_zeros() as usize),
+                ),
+                PacketRays::Planar {
+                    origins,
+                    directions,
+                    present,
+                } if present != 0 => (
+                    PacketInterval::of_rays::<L>(&origins, &directions, present),
+                    present,
+                    lane_vector(&directions, present.trailing_zeros() as usize),
+                ),
                 PacketRays::Rays(rays) => {
-                    for l in 0..PACKET {
-                        if let Some((origin, dir)) = rays[l] {
-                            slabs[g][l] = Some(SlabRay::new(origin, dir));
-                            cull[g][l] = f32::INFINITY;
-                            first = first.or(Some(dir));
-                        }
-                    }
-                    intervals[g] = PacketInterval::of(&slabs[g]);
+                    let slabs = rays.map(|ray| ray.map(|(origin, dir)| SlabRay::new(origin, dir)));
+                    let present =
+                        (0..PACKET).fold(0u16, |m, l| m | u16::from(rays[l].is_some()) << l);
+                    let Some(interval) = PacketInterval::of(&slabs) else {
+                        continue;
+                    };
+                    let first = rays[present.trailing_zeros() as usize].map(|(_, dir)| dir);
+                    (interval, present, first.expect("a present ray"))
+                }
+                _ => continue,
+            };
+            for (l, c) in cull[g].iter_mut().enumerate() {
+                if present >> l & 1 == 1 {
+                    *c = f32::INFINITY;
                 }
             }
+            first = first.or(Some(direction));
+            intervals[g] = Some(interval);
         }
         let Some(first) = first else {
             return 0;
@@ -253,7 +259,7 @@ impl SceneBvh {
         // Each group's largest culling distance, renewed after each leaf
         // (−∞: a group without rays).
         let mut tmax = [f32::NEG_INFINITY; G];
-        largest_per_group(&cull, &mut tmax);
+        largest_per_group::<L, G>(&cull, &mut tmax);
         let mut visited = 0u64;
         let bvh = &self.cwbvh;
         let mut state = bvh.new_traversal(Vec3A::from(first));
@@ -270,22 +276,12 @@ impl SceneBvh {
                 let boxes = &Children::<L>::decode(node);
                 let mut hits = 0;
                 for g in 0..G {
-                    if tmax[g] == f32::NEG_INFINITY {
-                        continue;
+                    // (A group without rays has no interval and culls at −∞.)
+                    if let Some(interval) = &intervals[g]
+                        && tmax[g] != f32::NEG_INFINITY
+                    {
+                        hits |= interval.hits::<L>(boxes, tmax[g]);
                     }
-                    hits |= match &intervals[g] {
-                        Some(interval) => interval.hits::<L>(boxes, tmax[g]),
-                        // A loop, not a closure: lane code must be inlined (see `crate::simd`).
-                        None => {
-                            let mut hits = 0;
-                            for (slab, &tmax) in slabs[g].iter().zip(&cull[g]) {
-                                if let Some(slab) = slab {
-                                    hits |= slab.hits8::<L>(boxes, tmax);
-                                }
-                            }
-                            hits
-                        }
-                    };
                 }
                 child_mask(node, hits, state.oct_inv4)
             },
@@ -293,7 +289,7 @@ impl SceneBvh {
                 // Most leaf triangles miss every ray: the culling distances
                 // are renewed only when a hit moved one.
                 if leaf(state.primitive_id, &mut cull) {
-                    largest_per_group(&cull, &mut tmax);
+                    largest_per_group::<L, G>(&cull, &mut tmax);
                 }
             }
         );
@@ -301,14 +297,16 @@ impl SceneBvh {
     }
 }
 
-/// Each group's largest culling distance.
+/// Each group's largest culling distance (distances are never NaN: the
+/// maximum is the same in any order).
 #[inline(always)]
-fn largest_per_group<const G: usize>(cull: &[[f32; PACKET]; G], tmax: &mut [f32; G]) {
+fn largest_per_group<L: Lanes, const G: usize>(cull: &[[f32; PACKET]; G], tmax: &mut [f32; G]) {
+    const { assert!(PACKET == 16) };
     for g in 0..G {
-        tmax[g] = f32::NEG_INFINITY;
-        for &c in &cull[g] {
-            tmax[g] = tmax[g].max(c);
-        }
+        let (lo, hi) = cull[g].split_at(8);
+        let (lo, hi): ([f32; 8], [f32; 8]) = (lo.try_into().expect("8"), hi.try_into().expect("8"));
+        let largest = L::from_array(lo).max(L::from_array(hi)).to_array();
+        tmax[g] = largest.into_iter().fold(f32::NEG_INFINITY, f32::max);
     }
 }
 
@@ -357,21 +355,65 @@ fn overlapping<L: Lanes>([(nx, fx), (ny, fy), (nz, fz)]: [(L, L); 3], tmax: f32)
     u32::from(near.le(far))
 }
 
-/// The slab tests of a packet of rays from one origin, by interval arithmetic
-/// over the packet (Wald et al. style): per axis the smallest and largest
-/// reciprocal direction of its rays. For a box coordinate `q` every ray's slab
-/// distance is the rounded product `(q − o)·inv`, which is monotonic in `inv`,
-/// so the products with the two extremes bound every ray's exactly, and so do
-/// the min/max combinations of them: a box is missed by every ray when the
-/// packet's nearest possible entry lies beyond its farthest possible exit (or
-/// beyond every ray's culling distance). Conservative against each ray's own
-/// `SlabRay::hits8` bit for bit, so no ray loses a node its single walk enters.
+/// The slab tests of a packet of rays by interval arithmetic over the packet
+/// (Wald et al. style): per axis the smallest and largest reciprocal
+/// direction of its rays, and the smallest and largest of their (padded)
+/// origins — one origin for a perspective view's rays, a range for an
+/// orthographic view's parallel rays. For a box coordinate `q` every ray's
+/// slab distance is the rounded `(q − o)·inv`, which is monotonic in `o` and
+/// in `inv`, so the distances at the ranges' ends bound every ray's exactly,
+/// and so do the min/max combinations of them: a box is missed by every ray
+/// when the packet's nearest possible entry lies beyond its farthest
+/// possible exit (or beyond every ray's culling distance). Conservative
+/// against each ray's own `SlabRay::hits8` bit for bit, so no ray loses a
+/// node its single walk enters.
 #[derive(Clone, Copy, Debug)]
 pub struct PacketInterval {
-    origin_lo: [f32; 3],
-    origin_hi: [f32; 3],
+    /// Per axis, the least and the greatest `SlabRay::origin_lo` of the rays.
+    origin_lo: [[f32; 3]; 2],
+    /// Per axis, the least and the greatest `SlabRay::origin_hi` of the rays.
+    origin_hi: [[f32; 3]; 2],
     inv_min: [f32; 3],
     inv_max: [f32; 3],
+    /// Every ray has the same origin (each range is one value).
+    one_origin: bool,
+}
+
+/// Per axis, the least and greatest reciprocal of `directions[axis][lane]`
+/// over the lanes of `present` (at least one), as [`SlabRay`] takes it
+/// ([`safe_direction`]), eight lanes at a time: IEEE division, so each lane
+/// rounds as the scalar one, and minima and maxima of nonzero finite values,
+/// exact in any order.
+#[inline(always)]
+fn inverse_range<L: Lanes>(directions: &[[f32; PACKET]; 3], present: u16) -> ([f32; 3], [f32; 3]) {
+    const { assert!(PACKET == 16) };
+    let first = present.trailing_zeros() as usize;
+    let (mut inv_min, mut inv_max) = ([0.0; 3], [0.0; 3]);
+    for a in 0..3 {
+        // Absent lanes repeat the first present one: no effect on min/max.
+        let fill = L::splat(directions[a][first]);
+        let (mut lo, mut hi) = (L::splat(f32::INFINITY), L::splat(f32::NEG_INFINITY));
+        for (half, chunk) in directions[a].chunks_exact(8).enumerate() {
+            let lanes = (present >> (8 * half)) as u8;
+            let chunk: [f32; 8] = chunk.try_into().expect("eight lanes");
+            let mut d = L::select(lanes, L::from_array(chunk), fill);
+            // Components below the tiny bound (rare) as the scalar path takes them.
+            if d.lt(L::splat(TINY_DIRECTION)) & d.gt(L::splat(-TINY_DIRECTION)) != 0 {
+                d = L::from_array(d.to_array().map(safe_direction));
+            }
+            let inv = L::splat(1.0) / d;
+            (lo, hi) = (lo.min(inv), hi.max(inv));
+        }
+        inv_min[a] = lo.to_array().into_iter().fold(f32::INFINITY, f32::min);
+        inv_max[a] = hi.to_array().into_iter().fold(f32::NEG_INFINITY, f32::max);
+    }
+    (inv_min, inv_max)
+}
+
+/// Lane `l` of vectors in lanes, `v[axis][lane]`.
+#[inline(always)]
+fn lane_vector(v: &[[f32; PACKET]; 3], l: usize) -> Vec3 {
+    Vec3::new(v[0][l], v[1][l], v[2][l])
 }
 
 /// The rays of a packet for [`SceneBvh::walk_packet`].
@@ -381,6 +423,13 @@ pub enum PacketRays<'r> {
     /// `present` (bit per lane) take no part and may hold anything.
     OneOrigin {
         origin: Vec3,
+        directions: [[f32; PACKET]; 3],
+        present: u16,
+    },
+    /// Rays from `origins[axis][lane]` along `directions[axis][lane]`
+    /// (an orthographic view's); lanes outside `present` as above.
+    Planar {
+        origins: [[f32; PACKET]; 3],
         directions: [[f32; PACKET]; 3],
         present: u16,
     },
@@ -400,46 +449,67 @@ impl PacketInterval {
         present: u16,
     ) -> PacketInterval {
         let (origin_lo, origin_hi) = padded_origin(origin);
-        let first = present.trailing_zeros() as usize;
-        let (mut inv_min, mut inv_max) = ([0.0; 3], [0.0; 3]);
-        for a in 0..3 {
-            // Absent lanes repeat the first present one: no effect on min/max.
-            let mut safe = [[0.0; 8]; PACKET / 8];
-            for l in 0..PACKET {
-                let d = directions[a][if present >> l & 1 == 1 { l } else { first }];
-                safe[l / 8][l % 8] = safe_direction(d);
-            }
-            let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-            for half in safe {
-                for inv in (L::splat(1.0) / L::from_array(half)).to_array() {
-                    (lo, hi) = (lo.min(inv), hi.max(inv));
-                }
-            }
-            (inv_min[a], inv_max[a]) = (lo, hi);
+        let (inv_min, inv_max) = inverse_range::<L>(directions, present);
+        PacketInterval {
+            origin_lo: [origin_lo; 2],
+            origin_hi: [origin_hi; 2],
+            inv_min,
+            inv_max,
+            one_origin: true,
         }
+    }
+
+    /// The interval of rays from `origins[axis][lane]` along
+    /// `directions[axis][lane]` (lanes in `present`, at least one): the
+    /// same bounds as [`PacketInterval::of`] on their [`SlabRay`]s.
+    #[inline(always)]
+    pub fn of_rays<L: Lanes>(
+        origins: &[[f32; PACKET]; 3],
+        directions: &[[f32; PACKET]; 3],
+        present: u16,
+    ) -> PacketInterval {
+        let origin = |l: usize| lane_vector(origins, l);
+        let first = origin(present.trailing_zeros() as usize);
+        let (lo, hi) = padded_origin(first);
+        let (mut origin_lo, mut origin_hi, mut one_origin) = ([lo; 2], [hi; 2], true);
+        for l in (0..PACKET).filter(|&l| present >> l & 1 == 1) {
+            let (lo, hi) = padded_origin(origin(l));
+            one_origin &= origin(l) == first;
+            for a in 0..3 {
+                origin_lo[0][a] = origin_lo[0][a].min(lo[a]);
+                origin_lo[1][a] = origin_lo[1][a].max(lo[a]);
+                origin_hi[0][a] = origin_hi[0][a].min(hi[a]);
+                origin_hi[1][a] = origin_hi[1][a].max(hi[a]);
+            }
+        }
+        let (inv_min, inv_max) = inverse_range::<L>(directions, present);
         PacketInterval {
             origin_lo,
             origin_hi,
             inv_min,
             inv_max,
+            one_origin,
         }
     }
 
-    /// `None` unless every present ray has the same origin (and some ray is present).
+    /// The interval of the present rays (`None` when there is none).
     pub fn of(slabs: &[Option<SlabRay>]) -> Option<PacketInterval> {
         let mut present = slabs.iter().flatten();
         let first = present.next()?;
         let mut interval = PacketInterval {
-            origin_lo: first.origin_lo,
-            origin_hi: first.origin_hi,
+            origin_lo: [first.origin_lo; 2],
+            origin_hi: [first.origin_hi; 2],
             inv_min: first.inv,
             inv_max: first.inv,
+            one_origin: true,
         };
         for slab in present {
-            if slab.origin != first.origin {
-                return None;
-            }
+            interval.one_origin &= slab.origin == first.origin;
             for a in 0..3 {
+                let [lo, hi] = &mut interval.origin_lo;
+                (lo[a], hi[a]) = (lo[a].min(slab.origin_lo[a]), hi[a].max(slab.origin_lo[a]));
+                let [lo, hi] = &mut interval.origin_hi;
+                (lo[a], hi[a]) = (lo[a].min(slab.origin_hi[a]), hi[a].max(slab.origin_hi[a]));
                 interval.inv_min[a] = interval.inv_min[a].min(slab.inv[a]);
                 interval.inv_max[a] = interval.inv_max[a].max(slab.inv[a]);
             }
@@ -466,12 +536,22 @@ impl PacketInterval {
     #[inline(always)]
     fn axis<L: Lanes>(&self, boxes: &Children<L>, a: usize) -> (L, L) {
         let (lo, hi) = (L::splat(self.inv_min[a]), L::splat(self.inv_max[a]));
-        let below = boxes.lo[a] - L::splat(self.origin_lo[a]);
-        let above = boxes.hi[a] - L::splat(self.origin_hi[a]);
+        // The differences at the least origins (the largest differences) ...
+        let below = boxes.lo[a] - L::splat(self.origin_lo[0][a]);
+        let above = boxes.hi[a] - L::splat(self.origin_hi[0][a]);
         let (ta_lo, ta_hi) = (below * lo, below * hi);
         let (tb_lo, tb_hi) = (above * lo, above * hi);
-        let near = ta_lo.min(ta_hi).min(tb_lo.min(tb_hi));
-        let far = ta_lo.max(ta_hi).max(tb_lo.max(tb_hi));
+        let mut near = ta_lo.min(ta_hi).min(tb_lo.min(tb_hi));
+        let mut far = ta_lo.max(ta_hi).max(tb_lo.max(tb_hi));
+        if !self.one_origin {
+            // ... and at the greatest (the smallest).
+            let below = boxes.lo[a] - L::splat(self.origin_lo[1][a]);
+            let above = boxes.hi[a] - L::splat(self.origin_hi[1][a]);
+            let (ta_lo, ta_hi) = (below * lo, below * hi);
+            let (tb_lo, tb_hi) = (above * lo, above * hi);
+            near = near.min(ta_lo.min(ta_hi).min(tb_lo.min(tb_hi)));
+            far = far.max(ta_lo.max(ta_hi).max(tb_lo.max(tb_hi)));
+        }
         (near, far)
     }
 }
@@ -587,21 +667,32 @@ mod tests {
 
     /// The packet's interval test never misses a child box that one of its
     /// rays' own slab test meets: random packets from one origin (nearly
-    /// parallel, spread, and with direction components of both signs) against
+    /// parallel, spread, and with direction components of both signs) and
+    /// of parallel rays from spread origins (orthographic views), against
     /// random boxes and culling distances.
     #[test]
     fn the_interval_test_keeps_every_box_a_ray_meets() {
         let mut rng = fastrand::Rng::with_seed(11);
         let mut f = move |lo: f32, hi: f32| lo + rng.f32() * (hi - lo);
-        let (mut met, mut kept_extra) = (0u32, 0u32);
-        for case in 0..4000 {
+        let (mut met, mut kept_extra, mut parallel) = (0u32, 0u32, 0);
+        for case in 0..6000 {
             let origin = Vec3::new(f(-5.0, 5.0), f(-5.0, 5.0), f(-5.0, 5.0));
             let centre = Vec3::new(f(-1.0, 1.0), f(-1.0, 1.0), f(-1.0, 1.0)).normalize_or(Vec3::X);
-            let spread = [1e-4, 1e-2, 0.5][case % 3];
-            let mut dir = || centre + Vec3::new(f(-1.0, 1.0), f(-1.0, 1.0), f(-1.0, 1.0)) * spread;
-            let slabs: Vec<Option<SlabRay>> = (0..PACKET)
-                .map(|l| (l % 5 != 4).then(|| SlabRay::new(origin, dir())))
-                .collect();
+            // Cases 3 and 4 of 5: one direction from origins spread apart.
+            let (spread, apart) = [
+                (1e-4, 0.0),
+                (1e-2, 0.0),
+                (0.5, 0.0),
+                (0.0, 0.05),
+                (0.0, 2.0),
+            ][case % 5];
+            let mut ray = || {
+                let dir = centre + Vec3::new(f(-1.0, 1.0), f(-1.0, 1.0), f(-1.0, 1.0)) * spread;
+                let at = origin + Vec3::new(f(-1.0, 1.0), f(-1.0, 1.0), f(-1.0, 1.0)) * apart;
+                SlabRay::new(at, dir)
+            };
+            let slabs: Vec<Option<SlabRay>> =
+                (0..PACKET).map(|l| (l % 5 != 4).then(&mut ray)).collect();
             let tmax: Vec<f32> = (0..PACKET).map(|_| f(0.0, 20.0)).collect();
             let (mut lo, mut hi) = ([[0.0; 8]; 3], [[0.0; 8]; 3]);
             for c in 0..8 {
@@ -614,7 +705,9 @@ mod tests {
                 lo: lo.map(lanes::<Portable>),
                 hi: hi.map(lanes::<Portable>),
             };
-            let interval = PacketInterval::of(&slabs).expect("one origin");
+            let interval = PacketInterval::of(&slabs).expect("rays");
+            assert_eq!(interval.one_origin, apart == 0.0);
+            parallel += usize::from(!interval.one_origin);
             let packet = interval.hits::<Portable>(&boxes, tmax.iter().fold(0.0, |m, &t| m.max(t)));
             let rays = slabs
                 .iter()
@@ -625,10 +718,11 @@ mod tests {
             met += rays.count_ones();
             kept_extra += (packet & !rays).count_ones();
         }
-        assert!(met > 2000, "only {met} boxes met: the cases test little");
+        assert!(met > 3000, "only {met} boxes met: the cases test little");
+        assert_eq!(parallel, 2400);
         // Conservative, not everything: the test still rejects boxes.
         assert!(
-            kept_extra < 4000 * 8 - met,
+            kept_extra < 6000 * 8 - met,
             "the interval test kept every box"
         );
     }
@@ -692,42 +786,71 @@ mod tests {
         Children::decode(node)
     }
 
-    /// The interval built from directions eight lanes at a time is the one
-    /// built from the rays' own slab rays, field for field, on both lane
-    /// types: random packets with absent lanes, tiny and zero components.
+    /// The interval built from directions (and origins) eight lanes at a
+    /// time is the one built from the rays' own slab rays, field for field,
+    /// on both lane types: random packets with absent lanes, tiny and zero
+    /// components, from one origin and (orthographic views) from several.
     #[test]
-    fn the_interval_from_directions_is_the_interval_of_the_rays() {
+    fn the_interval_from_lanes_is_the_interval_of_the_rays() {
         let mut rng = fastrand::Rng::with_seed(12);
+        let mut several = 0;
         for case in 0..3000 {
             let origin = Vec3::new(rng.f32() - 0.5, rng.f32() * 1e3, -rng.f32()) * 7.0;
             let present = (rng.u32(..) as u16) | 1 << rng.usize(0..PACKET);
-            let mut directions = [[0.0; PACKET]; 3];
-            for axis in &mut directions {
-                for d in axis.iter_mut() {
+            let (mut directions, mut origins) = ([[0.0; PACKET]; 3], [[0.0; PACKET]; 3]);
+            for (axis, d) in directions.iter_mut().enumerate() {
+                for (l, d) in d.iter_mut().enumerate() {
                     *d = match rng.u8(0..8) {
                         0 => 0.0,
                         1 => -1e-31,
                         _ => rng.f32() * 4.0 - 2.0,
                     };
+                    // Every other case: origins apart (from 0 to 3 units).
+                    let apart = (case % 2) as f32 * rng.f32() * 3.0;
+                    origins[axis][l] = origin[axis] + apart;
                 }
             }
             let slabs: Vec<Option<SlabRay>> = (0..PACKET)
                 .map(|l| {
-                    let d = Vec3::new(directions[0][l], directions[1][l], directions[2][l]);
-                    (present >> l & 1 == 1).then(|| SlabRay::new(origin, d))
+                    let (o, d) = (lane_vector(&origins, l), lane_vector(&directions, l));
+                    (present >> l & 1 == 1).then(|| SlabRay::new(o, d))
                 })
                 .collect();
-            let expected = PacketInterval::of(&slabs).expect("one origin");
-            let fields = |i: PacketInterval| (i.origin_lo, i.origin_hi, i.inv_min, i.inv_max);
-            let portable = PacketInterval::of_directions::<Portable>(origin, &directions, present);
+            let expected = PacketInterval::of(&slabs).expect("rays");
+            several += usize::from(!expected.one_origin);
+            let fields =
+                |i: PacketInterval| (i.origin_lo, i.origin_hi, i.inv_min, i.inv_max, i.one_origin);
+            let portable = match case % 2 {
+                0 => PacketInterval::of_directions::<Portable>(origin, &directions, present),
+                _ => PacketInterval::of_rays::<Portable>(&origins, &directions, present),
+            };
             assert_eq!(fields(portable), fields(expected), "case {case}");
             #[cfg(target_arch = "x86_64")]
             if crate::simd::cpu_has_avx2() {
                 // SAFETY: this CPU has AVX2.
-                let avx2 = unsafe { of_directions_avx2(origin, &directions, present) };
+                let avx2 = unsafe {
+                    match case % 2 {
+                        0 => of_directions_avx2(origin, &directions, present),
+                        _ => of_lanes_avx2(&origins, &directions, present),
+                    }
+                };
                 assert_eq!(fields(avx2), fields(expected), "case {case} (AVX2)");
             }
         }
+        assert!(
+            several > 1000,
+            "only {several} packets from several origins"
+        );
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn of_lanes_avx2(
+        origins: &[[f32; PACKET]; 3],
+        directions: &[[f32; PACKET]; 3],
+        present: u16,
+    ) -> PacketInterval {
+        PacketInterval::of_rays::<crate::simd::Avx2>(origins, directions, present)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -740,16 +863,26 @@ mod tests {
         PacketInterval::of_directions::<crate::simd::Avx2>(origin, directions, present)
     }
 
-    /// Rays from different origins (orthographic views) are walked ray by ray.
+    /// Rays from different origins (orthographic views) have an interval
+    /// over the range of their padded origins; no ray, none.
     #[test]
-    fn rays_from_several_origins_have_no_interval() {
+    fn rays_from_several_origins_have_an_interval_over_their_origins() {
         let slabs = [
-            Some(SlabRay::new(Vec3::ZERO, Vec3::Z)),
+            Some(SlabRay::new(Vec3::new(0.0, 2.0, -1.0), Vec3::Z)),
             None,
-            Some(SlabRay::new(Vec3::X, Vec3::Z)),
+            Some(SlabRay::new(Vec3::new(1.0, -3.0, -1.0), Vec3::Z)),
         ];
-        assert!(PacketInterval::of(&slabs).is_none());
-        assert!(PacketInterval::of(&slabs[..2]).is_some());
+        let interval = PacketInterval::of(&slabs).expect("rays");
+        assert!(!interval.one_origin);
+        for slab in slabs.iter().flatten() {
+            for a in 0..3 {
+                let [lo, hi] = interval.origin_lo;
+                assert!(lo[a] <= slab.origin_lo[a] && slab.origin_lo[a] <= hi[a]);
+                let [lo, hi] = interval.origin_hi;
+                assert!(lo[a] <= slab.origin_hi[a] && slab.origin_hi[a] <= hi[a]);
+            }
+        }
+        assert!(PacketInterval::of(&slabs[..2]).expect("one ray").one_origin);
         assert!(PacketInterval::of(&[None]).is_none());
     }
 }

@@ -6,6 +6,8 @@
 
 use std::time::Instant;
 
+use glam::Vec3;
+
 use super::tiles::Setups;
 use super::{Pass, PixelRect, TileContext};
 use crate::aa::SamplePattern;
@@ -30,6 +32,13 @@ const BLOCK: u32 = 4;
 const _: () = assert!((BLOCK * BLOCK) as usize == PACKET);
 /// 8-lane halves of a group of rays.
 const HALVES: usize = PACKET.div_ceil(8);
+const _: () = assert!(HALVES == 2 && BLOCK == 4);
+/// Each lane's column and row in its group's 4×4 block, per half.
+const LANE_X: [f32; 8] = [0.0, 1.0, 2.0, 3.0, 0.0, 1.0, 2.0, 3.0];
+const LANE_Y: [[f32; 8]; HALVES] = [
+    [0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
+    [2.0, 2.0, 2.0, 2.0, 3.0, 3.0, 3.0, 3.0],
+];
 
 /// Casts one ray per stored sample; `setup` gives the same triangles the 3D
 /// rasterizers of this viewport use. Under CSAA the coverage-only positions are
@@ -115,53 +124,52 @@ fn cast_band_on<L: Lanes, T: Stored, const G: usize>(
     let mut nodes = 0;
     // The nodes the packets entered, when the render is traced.
     let mut trace_nodes: Option<Vec<u32>> = tile.trace.is_some().then(Vec::new);
-    // Planar perspective views: every ray leaves the eye along
-    // `View::direction`, computed here for the packet eight lanes at a time.
-    let perspective = view.sphere.is_none() && !view.is_orthographic();
+    // Planar views: every ray leaves the eye (perspective) or its own
+    // origin on the image plane (orthographic) along `View::direction`,
+    // computed here for the packet eight lanes at a time.
+    let planar = view.sphere.is_none();
+    let perspective = planar && !view.is_orthographic();
     // Per group and lane: the BVH slot of each stored sample's triangle (CSAA).
     let mut slots = [[[0u32; 8]; PACKET]; G];
+    // Each lane's pixel offset in its group's 4×4 block.
+    let lane_x = L::from_array(LANE_X);
+    let lane_y = [L::from_array(LANE_Y[0]), L::from_array(LANE_Y[1])];
+    let width = (tile.x1 - tile.x0) as usize;
     for y in (tile.y0..tile.y1).step_by(side as usize) {
         for x in (tile.x0..tile.x1).step_by(side as usize) {
-            // Each group's corner, its pixels inside the tile (`None` beyond
-            // its edges) and their buffer indices. Plain loops, no closures:
-            // this is lane code (see `crate::simd`).
+            // Each group's corner, and its pixels inside the tile (bit per
+            // lane; all sixteen but at the band's right and bottom edges).
             let mut corner = [(0, 0); G];
-            let (mut block, mut index) = ([[None; PACKET]; G], [[0; PACKET]; G]);
+            let mut inside_tile = [0u16; G];
             for g in 0..G {
                 let (gx, gy) = (g as u32 % columns, g as u32 / columns);
                 corner[g] = (x + gx * BLOCK, y + gy * BLOCK);
-                for l in 0..PACKET {
-                    let (px, py) = (
-                        corner[g].0 + l as u32 % BLOCK,
-                        corner[g].1 + l as u32 / BLOCK,
-                    );
-                    if px < tile.x1 && py < tile.y1 {
-                        (block[g][l], index[g][l]) = (Some((px, py)), tile.index(px, py));
-                    }
-                }
+                inside_tile[g] = block_mask(tile.rect(), corner[g].0, corner[g].1);
             }
             for (s, &[ox, oy]) in pattern.positions[..stored].iter().enumerate() {
-                // Each group's rays (none outside the viewport, e.g. the
-                // parabolic disc: background) and their samples as two 8-lane
-                // tests (`cast`: bit per lane whose ray is cast).
+                // Each group's samples as two 8-lane halves (lane `l` at
+                // pixel `corner + (l % 4, l / 4)`: `px as f32 + ox`, exact
+                // as the pixel's integer coordinates are), and the rays cast
+                // (`cast`: bit per lane; none outside the viewport, e.g. the
+                // parabolic disc: background). Lanes outside the tile hold
+                // points that take no part.
                 let mut rays = [[None; PACKET]; G];
                 let mut xs = [[[0.0; 8]; HALVES]; G];
                 let mut ys = [[[0.0; 8]; HALVES]; G];
-                let mut cast = [0u16; G];
+                let mut cast = inside_tile;
                 for g in 0..G {
-                    for l in 0..PACKET {
-                        let Some((px, py)) = block[g][l] else {
-                            continue;
-                        };
-                        let (sx, sy) = (px as f32 + ox, py as f32 + oy);
-                        if !perspective {
-                            rays[g][l] = view.ray(sx, sy);
-                            if rays[g][l].is_none() {
-                                continue;
+                    let (cx, cy) = (corner[g].0 as f32, corner[g].1 as f32);
+                    for half in 0..HALVES {
+                        xs[g][half] = ((L::splat(cx) + lane_x) + L::splat(ox)).to_array();
+                        ys[g][half] = ((L::splat(cy) + lane_y[half]) + L::splat(oy)).to_array();
+                    }
+                    if !planar {
+                        for l in 0..PACKET {
+                            if cast[g] >> l & 1 == 1 {
+                                rays[g][l] = view.ray(xs[g][l / 8][l % 8], ys[g][l / 8][l % 8]);
+                                cast[g] &= !(u16::from(rays[g][l].is_none()) << l);
                             }
                         }
-                        (xs[g][l / 8][l % 8], ys[g][l / 8][l % 8]) = (sx, sy);
-                        cast[g] |= 1 << l;
                     }
                 }
                 let mut packet = [PacketRays::Rays(&rays[0]); G];
@@ -172,17 +180,28 @@ fn cast_band_on<L: Lanes, T: Stored, const G: usize>(
                             directions: directions_lanes::<L>(view, &xs[g], &ys[g]),
                             present: cast[g],
                         }
+                    } else if planar {
+                        PacketRays::Planar {
+                            origins: origins_lanes::<L>(view, &xs[g], &ys[g]),
+                            directions: directions_lanes::<L>(view, &xs[g], &ys[g]),
+                            present: cast[g],
+                        }
                     } else {
                         PacketRays::Rays(&rays[g])
                     };
                 }
-                let mut best = [[(f32::INFINITY, BACKGROUND, 0u32); PACKET]; G];
+                // Per group and lane, the nearest hit: its depth, triangle
+                // id and BVH slot.
+                let mut best_w = [[f32::INFINITY; PACKET]; G];
+                let mut best_id = [[BACKGROUND; PACKET]; G];
+                let mut best_slot = [[0u32; PACKET]; G];
                 // Every ray of the packet tests every triangle it reaches
                 // whose screen box holds its pixel.
                 let (mut tested, mut covered) = ([[0u32; PACKET]; G], [[0u32; PACKET]; G]);
                 // See-through triangles leave fragments, as in the rasterizers'
                 // `TileBuffer::write`; the walk still culls beyond the nearest
                 // opaque hit, behind which no fragment shows.
+                let (x0, y0) = (tile.x0, tile.y0);
                 let opacity = tile.opacity;
                 let fragments = &mut tile.fragments;
                 let entered = trace_nodes.as_mut();
@@ -228,13 +247,19 @@ fn cast_band_on<L: Lanes, T: Stored, const G: usize>(
                                 let (w, lane) = (depth[l], half * 8 + l);
                                 covered[g][lane] += 1;
                                 if see_through {
+                                    let (px, py) = (corner[g].0, corner[g].1);
+                                    let (px, py) =
+                                        (px + lane as u32 % BLOCK, py + lane as u32 / BLOCK);
+                                    let i = (py - y0) as usize * width + (px - x0) as usize;
                                     fragments.push(Fragment {
-                                        sample: (s * pixels + index[g][lane]) as u32,
+                                        sample: (s * pixels + i) as u32,
                                         w,
                                         id,
                                     });
-                                } else if wins_depth_test(w, id, best[g][lane].0, best[g][lane].1) {
-                                    best[g][lane] = (w, id, k);
+                                } else if wins_depth_test(w, id, best_w[g][lane], best_id[g][lane])
+                                {
+                                    (best_w[g][lane], best_id[g][lane]) = (w, id);
+                                    best_slot[g][lane] = k;
                                     cull[g][lane] = w * CULL_MARGIN;
                                     moved = true;
                                 }
@@ -243,26 +268,56 @@ fn cast_band_on<L: Lanes, T: Stored, const G: usize>(
                     }
                     moved
                 });
+                // Each group's results into the tile, a row of four lanes at
+                // a time where the row is in the tile (lanes not cast keep
+                // no result: outside the tile, or without a ray).
                 for g in 0..G {
-                    for l in 0..PACKET {
-                        if cast[g] >> l & 1 == 0 {
+                    let (cx, cy) = corner[g];
+                    let first = (cy - y0) as usize * width + (cx - x0) as usize;
+                    for r in 0..BLOCK as usize {
+                        let row = (inside_tile[g] >> (r * 4)) & 0xf;
+                        if row == 0 {
                             continue;
                         }
-                        let (i, j) = (index[g][l], s * pixels + index[g][l]);
-                        tile.edge_evals[i] += tested[g][l];
-                        tile.coverage_writes[j] = covered[g][l];
-                        let (w, id, slot) = best[g][l];
-                        (tile.depth[j], tile.triangle_id[j]) = (w, id);
-                        if pattern.has_coverage_only() {
-                            slots[g][l][s] = slot;
+                        let (i, lanes) = (first + r * width, r * 4..r * 4 + 4);
+                        let j = s * pixels + i;
+                        if row == 0xf && cast[g] >> (r * 4) & 0xf == 0xf {
+                            for (e, &t) in tile.edge_evals[i..i + 4]
+                                .iter_mut()
+                                .zip(&tested[g][lanes.clone()])
+                            {
+                                *e += t;
+                            }
+                            tile.coverage_writes[j..j + 4]
+                                .copy_from_slice(&covered[g][lanes.clone()]);
+                            tile.depth[j..j + 4].copy_from_slice(&best_w[g][lanes.clone()]);
+                            tile.triangle_id[j..j + 4].copy_from_slice(&best_id[g][lanes]);
+                        } else {
+                            for (c, l) in lanes.enumerate() {
+                                if cast[g] >> l & 1 == 1 {
+                                    tile.edge_evals[i + c] += tested[g][l];
+                                    tile.coverage_writes[j + c] = covered[g][l];
+                                    (tile.depth[j + c], tile.triangle_id[j + c]) =
+                                        (best_w[g][l], best_id[g][l]);
+                                }
+                            }
+                        }
+                    }
+                    if pattern.has_coverage_only() {
+                        for l in 0..PACKET {
+                            slots[g][l][s] = best_slot[g][l];
                         }
                     }
                 }
             }
             if pattern.has_coverage_only() {
                 for g in 0..G {
-                    for (l, p) in block[g].into_iter().enumerate() {
-                        if let Some(p) = p {
+                    for l in 0..PACKET {
+                        if inside_tile[g] >> l & 1 == 1 {
+                            let p = (
+                                corner[g].0 + l as u32 % BLOCK,
+                                corner[g].1 + l as u32 / BLOCK,
+                            );
                             stored_masks::<L, T>(setups, &slots[g][l], tile, p);
                             nodes += lost_coverage::<T>(scene, view, setups, tile, p);
                         }
@@ -291,16 +346,42 @@ fn directions_lanes<L: Lanes>(
     xs: &[[f32; 8]; HALVES],
     ys: &[[f32; 8]; HALVES],
 ) -> [[f32; PACKET]; 3] {
-    let (d0, dx, dy) = (view.d0.to_array(), view.dx.to_array(), view.dy.to_array());
-    let mut directions = [[0.0; PACKET]; 3];
+    planar_lanes::<L>([view.d0, view.dx, view.dy], xs, ys, None)
+}
+
+/// `View::origin` of the packet's samples `(xs, ys)`, per axis and lane:
+/// `eye + ((o0 + x·ox) + y·oy)` per component, bit for bit as the scalar form.
+#[inline(always)]
+fn origins_lanes<L: Lanes>(
+    view: &View,
+    xs: &[[f32; 8]; HALVES],
+    ys: &[[f32; 8]; HALVES],
+) -> [[f32; PACKET]; 3] {
+    planar_lanes::<L>([view.o0, view.ox, view.oy], xs, ys, Some(view.eye))
+}
+
+/// `(v0 + x·vx) + y·vy` per component and lane, in that order (no FMA),
+/// added to `base` when there is one.
+#[inline(always)]
+fn planar_lanes<L: Lanes>(
+    [v0, vx, vy]: [Vec3; 3],
+    xs: &[[f32; 8]; HALVES],
+    ys: &[[f32; 8]; HALVES],
+    base: Option<Vec3>,
+) -> [[f32; PACKET]; 3] {
+    let [v0, vx, vy] = [v0, vx, vy].map(|v| v.to_array());
+    let mut out = [[0.0; PACKET]; 3];
     for half in 0..HALVES {
         let (x, y) = (L::from_array(xs[half]), L::from_array(ys[half]));
         for a in 0..3 {
-            let d = L::splat(d0[a]) + L::splat(dx[a]) * x + L::splat(dy[a]) * y;
-            directions[a][half * 8..half * 8 + 8].copy_from_slice(&d.to_array());
+            let mut v = L::splat(v0[a]) + L::splat(vx[a]) * x + L::splat(vy[a]) * y;
+            if let Some(base) = base {
+                v = L::splat(base[a]) + v;
+            }
+            out[a][half * 8..half * 8 + 8].copy_from_slice(&v.to_array());
         }
     }
-    directions
+    out
 }
 
 /// CSAA: the coverage mask of each triangle the stored rays of pixel `(x, y)`
