@@ -214,24 +214,25 @@ impl SceneBvh {
         let mut intervals = [None; G];
         let mut first = None;
         for g in 0..G {
-            let (interval, present, direction) = match rays[g] {
-                PacketRays::OneOrigin {
+            // (By reference: a group's lanes are 200 bytes or more.)
+            let (interval, present, direction) = match &rays[g] {
+                &PacketRays::OneOrigin {
                     origin,
-                    directions,
+                    ref directions,
                     present,
                 } if present != 0 => (
-                    PacketInterval::of_directions::<L>(origin, &directions, present),
+                    PacketInterval::of_directions::<L>(origin, directions, present),
                     present,
-                    lane_vector(&directions, present.trailing_zeros() as usize),
+                    lane_vector(directions, present.trailing_zeros() as usize),
                 ),
-                PacketRays::Planar {
-                    origins,
-                    directions,
+                &PacketRays::Planar {
+                    ref origins,
+                    ref directions,
                     present,
                 } if present != 0 => (
-                    PacketInterval::of_rays::<L>(&origins, &directions, present),
+                    PacketInterval::of_rays::<L>(origins, directions, present),
                     present,
-                    lane_vector(&directions, present.trailing_zeros() as usize),
+                    lane_vector(directions, present.trailing_zeros() as usize),
                 ),
                 PacketRays::Rays(rays) => {
                     let slabs = rays.map(|ray| ray.map(|(origin, dir)| SlabRay::new(origin, dir)));

@@ -312,13 +312,13 @@ fn cast_band_on<L: Lanes, T: Stored, const G: usize>(
             }
             if pattern.has_coverage_only() {
                 for g in 0..G {
-                    for l in 0..PACKET {
+                    for (l, slots) in slots[g].iter().enumerate() {
                         if inside_tile[g] >> l & 1 == 1 {
                             let p = (
                                 corner[g].0 + l as u32 % BLOCK,
                                 corner[g].1 + l as u32 / BLOCK,
                             );
-                            stored_masks::<L, T>(setups, &slots[g][l], tile, p);
+                            stored_masks::<L, T>(setups, slots, tile, p);
                             nodes += lost_coverage::<T>(scene, view, setups, tile, p);
                         }
                     }
