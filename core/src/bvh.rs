@@ -189,9 +189,9 @@ impl SceneBvh {
     /// each on its own, by the group's [`PacketInterval`] (over one origin in
     /// perspective and spherical views, over the origins' range in
     /// orthographic ones) against its own largest culling distance: one
-    /// 8-lane test per node and group. So a packet whose groups diverge (one done behind a near
-    /// surface, another still open to the background) culls as its groups
-    /// would alone. `leaf(slot, cull)` is called for each primitive slot of
+    /// 8-lane test per node and group. So a packet whose groups diverge (one
+    /// done behind a near surface, another still open to the background)
+    /// culls as its groups would alone. `leaf(slot, cull)` is called for each primitive slot of
     /// every leaf the packet reaches, updates each lane's culling distance in
     /// `cull[group]` and says whether it changed any. Returns the number of
     /// nodes whose children were tested (once per node, for the packet), and
