@@ -453,6 +453,33 @@ impl<'p> TileBuffer<'p> {
         self.depth_lowered = false;
     }
 
+    /// Keeps what the tile holds (depths, triangle ids, coverage masks) and
+    /// forgets how it got there: the per-pixel counts and the see-through
+    /// fragments start again, and the hierarchical w-buffer is read afresh
+    /// from the depths (exact, where updates keep upper bounds) — the
+    /// `final_depth` oracle's start ([`crate::pipeline::TraversalOracles`]).
+    pub(crate) fn restart_counts(&mut self) {
+        self.coverage_writes.fill(0);
+        self.edge_evals.fill(0);
+        self.fragments.clear();
+        let rect = self.rect();
+        self.hiz.reset(rect);
+        self.hiz.update(rect, &self.depth, self.pixels);
+        self.depth_lowered = false;
+    }
+
+    /// Does every stored sample of the pixels of `r` (inside the tile) hold a
+    /// depth nearer than `w`?
+    pub(crate) fn all_nearer(&self, r: PixelRect, w: f32) -> bool {
+        let width = (r.x1 - r.x0) as usize;
+        (0..self.pattern.stored).all(|s| {
+            (r.y0..r.y1).all(|y| {
+                let start = s * self.pixels + self.index(r.x0, y);
+                self.depth[start..start + width].iter().all(|&d| d < w)
+            })
+        })
+    }
+
     /// The tile's pixels.
     pub(crate) fn rect(&self) -> PixelRect {
         PixelRect::new(self.x0, self.y0, self.x1, self.y1)

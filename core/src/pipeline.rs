@@ -8,8 +8,9 @@ use crate::ground::{AlgorithmId, FieldError};
 use crate::viewport::Viewport;
 
 /// Oracle settings a request puts on top of its algorithm's (paper §5, Fig. 7),
-/// in the CLI's words `key=value,…`: `outside`, `occluded`, `binning`,
-/// `early_z`, `incremental` (`on`/`off`), `split` (`off` or a size in pixels),
+/// in the CLI's words `key=value,…`: `outside`, `occluded`, `final_depth`,
+/// `binning`, `early_z`, `incremental` (`on`/`off`), `split` (`off` or a size
+/// in pixels),
 /// `frustum` and `leaf` (sizes in pixels), and `raycast`'s `packet` (the
 /// side in pixels of the block whose rays walk the BVH together: 4, 8 or
 /// 16). `None` keeps the algorithm's own.
@@ -17,6 +18,7 @@ use crate::viewport::Viewport;
 pub struct Oracles {
     pub outside: Option<bool>,
     pub occluded: Option<bool>,
+    pub final_depth: Option<bool>,
     pub split: Option<Option<u32>>,
     pub frustum: Option<u32>,
     pub binning: Option<bool>,
@@ -55,6 +57,7 @@ impl Oracles {
             match key {
                 "outside" => o.outside = switch()?,
                 "occluded" => o.occluded = switch()?,
+                "final_depth" => o.final_depth = switch()?,
                 "binning" => o.binning = switch()?,
                 "early_z" => o.early_z = switch()?,
                 "incremental" => o.incremental = switch()?,
@@ -64,7 +67,7 @@ impl Oracles {
                 "split" => o.split = Some(if value == "off" { None } else { Some(size()?) }),
                 _ => {
                     return Err(bad(format!(
-                        "unknown oracle '{key}'; oracles are: outside, occluded, split, frustum, binning, early_z, leaf, incremental, packet"
+                        "unknown oracle '{key}'; oracles are: outside, occluded, final_depth, split, frustum, binning, early_z, leaf, incremental, packet"
                     )));
                 }
             }
@@ -81,6 +84,7 @@ impl fmt::Display for Oracles {
         let switches = [
             ("outside", self.outside),
             ("occluded", self.occluded),
+            ("final_depth", self.final_depth),
             ("binning", self.binning),
             ("early_z", self.early_z),
             ("incremental", self.incremental),
@@ -152,6 +156,13 @@ pub struct TraversalOracles {
     pub outside: bool,
     /// `is_occluded`: cull nodes behind the hierarchical w-buffer.
     pub occluded: bool,
+    /// An oracle that knows the future: `is_occluded` reads the depths each
+    /// tile ends with (an uncounted first traversal renders them), sample by
+    /// sample over the node's screen box, so the counted traversal culls
+    /// every node that any test of a box's nearest depth against the depth
+    /// buffer could — the bound of occlusion culling with this BVH and these
+    /// frusta. Its times are of both traversals.
+    pub final_depth: bool,
     /// `split_frustum`: split down to this many pixels square (`None`: never).
     pub split: Option<u32>,
     /// `generate_samples` at leaves: how samples are enumerated.
@@ -237,6 +248,7 @@ impl AlgorithmId {
                 frustum,
                 outside,
                 occluded,
+                final_depth: false,
                 split,
                 samples,
             })
@@ -374,6 +386,10 @@ impl Pipeline {
             Pipeline::Frusta(t) => {
                 set(&mut t.outside, oracles.outside);
                 set(&mut t.occluded, oracles.occluded);
+                set(&mut t.final_depth, oracles.final_depth);
+                if t.final_depth && !t.occluded {
+                    return Err(bad("'final_depth' needs occluded=on"));
+                }
                 t.split = oracles.split.unwrap_or(t.split);
                 t.frustum = oracles.frustum.unwrap_or(t.frustum);
             }
@@ -381,6 +397,7 @@ impl Pipeline {
                 let traversal = [
                     ("outside", oracles.outside.is_some()),
                     ("occluded", oracles.occluded.is_some()),
+                    ("final_depth", oracles.final_depth.is_some()),
                     ("split", oracles.split.is_some()),
                     ("frustum", oracles.frustum.is_some()),
                 ];

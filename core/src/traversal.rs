@@ -280,6 +280,18 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
             return;
         }
         let root = self.node_box(bvh.total_aabb.min, bvh.total_aabb.max);
+        if self.oracles.final_depth {
+            // The oracle: an uncounted traversal renders the tile first, so
+            // that the counted one's occlusion tests read the depths it ends
+            // with (the same winners are written again: the image is the same).
+            let trace = self.tile.trace.take();
+            let f = Frustum::new(self.tile.rect(), self.view);
+            self.traverse(&f, NodeRef::Inner(0), root);
+            self.tile.trace = trace;
+            self.tile.restart_counts();
+            self.leaves.slots.fill(NO_LEAF);
+            (self.counters, self.nodes_visited, self.setups) = (RasterCounters::default(), 0, 0);
+        }
         let f = Frustum::new(self.tile.rect(), self.view);
         self.counters.frusta_created += 1;
         self.tile
@@ -454,7 +466,10 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
 
     /// Is the box behind what the hierarchical w-buffer holds: over the whole
     /// frustum, or over the pixels its screen box reaches in it when some
-    /// other pixels of the frustum are still empty ([`crate::hiz`])?
+    /// other pixels of the frustum are still empty ([`crate::hiz`])? Under
+    /// the `final_depth` oracle the second test reads every stored sample
+    /// of those pixels instead of their cells (a cell's farthest depth
+    /// covers all of its pixels, and can rise as more of them fill).
     fn is_occluded(&self, f: &Frustum, b: &NodeBox) -> bool {
         let hiz = &self.tile.hiz;
         let (farthest, nearest) = match f.depths.get() {
@@ -468,7 +483,8 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
         if b.min_w > farthest {
             return true;
         }
-        if b.min_w <= nearest {
+        let exact = self.oracles.final_depth;
+        if b.min_w <= nearest && !exact {
             // Not behind any cell's held depths: no need to project the box.
             return false;
         }
@@ -481,7 +497,10 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
             })[c],
         };
         rect.and_then(|r| r.intersect(f.rect))
-            .is_some_and(|r| self.tile.hiz.hides(r, b.min_w))
+            .is_some_and(|r| match exact {
+                true => self.tile.all_nearer(r, b.min_w),
+                false => self.tile.hiz.hides(r, b.min_w),
+            })
     }
 
     /// Split when the frustum is still larger than `min` and the node is not a

@@ -648,6 +648,11 @@ fn compare_measures_oracle_settings_beside_the_algorithms_own() {
     for (oracles, algorithms, says) in [
         ("split=16", "2dr-brute", "changes none"),
         ("bogus=1", "3dr-full", "unknown oracle"),
+        (
+            "final_depth=on,occluded=off",
+            "3dr-full",
+            "needs occluded=on",
+        ),
     ] {
         let bad = continuum(&[
             "compare",

@@ -92,6 +92,13 @@ impl Entry {
     }
 }
 
+/// The algorithms that take the traversal keys of the oracles.
+const BVH_TRAVERSALS: [AlgorithmId; 3] = [
+    AlgorithmId::ThreeDFrustumCull,
+    AlgorithmId::ThreeDFrustumSplit,
+    AlgorithmId::ThreeDFull,
+];
+
 /// The tuned entries: each setting of `settings` for every algorithm of
 /// `entries` whose pipeline it changes. A setting that is not valid oracle
 /// words, or that changes none of them, is an error naming `oracles`.
@@ -104,18 +111,28 @@ fn tuned_entries(entries: &[Entry], settings: &[String]) -> Result<Vec<Entry>, C
     for text in settings {
         let oracles = Oracles::parse(text).map_err(|e| bad(e.message))?;
         let before = tuned.len();
+        // Why a BVH algorithm of the sweep refused the setting, if one did.
+        let mut refused = None;
         for entry in entries {
             let Entry::Algorithm(a) = *entry else {
                 continue;
             };
             let own = a.pipeline();
-            if own.with_oracles(&oracles).is_ok_and(|p| p != own) {
-                tuned.push(Entry::Tuned(a, oracles));
+            match own.with_oracles(&oracles) {
+                Ok(p) if p != own => tuned.push(Entry::Tuned(a, oracles)),
+                Err(e) if BVH_TRAVERSALS.contains(&a) => {
+                    refused.get_or_insert(format!("{a}: {}", e.message));
+                }
+                _ => {}
             }
         }
         if tuned.len() == before {
+            let why = refused.unwrap_or_else(|| {
+                let names = BVH_TRAVERSALS.map(|a| a.as_str()).join(", ");
+                format!("the traversal keys need one of {names}")
+            });
             return Err(bad(format!(
-                "'{text}' changes none of the sweep's algorithms (the traversal keys need 3dr-frustum-cull, 3dr-frustum-split or 3dr-full)"
+                "'{text}' changes none of the sweep's algorithms ({why})"
             )));
         }
     }

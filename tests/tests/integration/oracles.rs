@@ -22,6 +22,7 @@ proptest! {
         camera in 0usize..2,
         outside in any::<bool>(),
         occluded in any::<bool>(),
+        final_depth in any::<bool>(),
         binning in any::<bool>(),
         early_z in any::<bool>(),
         split in prop::sample::select(vec!["off", "8", "16", "64"]),
@@ -31,8 +32,8 @@ proptest! {
         let p = prepared(scene);
         let camera = &p.scene.cameras[camera];
         let oracles = format!(
-            "outside={},occluded={},binning={},early_z={},split={split},frustum={frustum},leaf={leaf}",
-            on(outside), on(occluded), on(binning), on(early_z)
+            "outside={},occluded={},final_depth={},binning={},early_z={},split={split},frustum={frustum},leaf={leaf}",
+            on(outside), on(occluded), on(occluded && final_depth), on(binning), on(early_z)
         );
         let reference = render_with(&p, AlgorithmId::ThreeDBrute, camera, W, H);
         let out = render_with_oracles(&p, AlgorithmId::ThreeDFull, Some(&oracles), camera, W, H);
@@ -78,6 +79,9 @@ fn bad_oracles_are_errors_naming_the_field() {
         (AlgorithmId::Raycast, "packet=8,split=8"),
         (AlgorithmId::ThreeDFull, "packet=8"),
         (AlgorithmId::ThreeDFull, "binning"),
+        (AlgorithmId::ThreeDFull, "occluded=off,final_depth=on"),
+        (AlgorithmId::ThreeDBin, "final_depth=on"),
+        (AlgorithmId::Raycast, "final_depth=on"),
     ];
     for (algorithm, text) in cases {
         // The words through the front door, then the render.
@@ -128,6 +132,50 @@ fn occlusion_culling_culls_behind_partly_covered_frusta() {
         b.triangle_setups,
         a.triangle_setups
     );
+}
+
+/// The `final_depth` oracle (occlusion tests that read the depths each tile
+/// ends with, sample by sample) renders the same image and counts only its
+/// second traversal: fewer node visits, setups and edge tests than occlusion
+/// culling makes as it goes on `teapots` — a node the w-buffer hides at some
+/// moment lies behind every final depth over its box — and the per-pixel
+/// counts sum to the totals.
+#[test]
+fn the_final_depth_oracle_bounds_occlusion_culling() {
+    let p = prepared("teapots");
+    let camera = p.scene.first_camera();
+    let mut checked = 0;
+    for algorithm in [AlgorithmId::ThreeDFrustumSplit, AlgorithmId::ThreeDFull] {
+        let render = |oracles| render_with_oracles(&p, algorithm, Some(oracles), &camera, 320, 180);
+        let (going, known) = (render("occluded=on"), render("final_depth=on"));
+        assert!(id_differences(&going, &known).is_empty(), "{algorithm}");
+        let (fa, fb) = (&going.framebuffer, &known.framebuffer);
+        assert_eq!(
+            (&fa.depth, &fa.color),
+            (&fb.depth, &fb.color),
+            "{algorithm}"
+        );
+        let (a, b) = (&going.stats, &known.stats);
+        assert!(
+            b.bvh_nodes_visited < a.bvh_nodes_visited,
+            "{algorithm}: node visits {} with the final depths, {} as it goes",
+            b.bvh_nodes_visited,
+            a.bvh_nodes_visited
+        );
+        // Measured: 0.70 of the setups; reading the depths per sample as they
+        // come (no first traversal) set up 0.76.
+        assert!(
+            b.triangle_setups * 100 < a.triangle_setups * 73,
+            "{algorithm}: triangle setups {} with the final depths, {} as it goes",
+            b.triangle_setups,
+            a.triangle_setups
+        );
+        assert!(b.edge_evaluations <= a.edge_evaluations, "{algorithm}");
+        let sum: u64 = fb.edge_evals.iter().map(|&e| u64::from(e)).sum();
+        assert_eq!(sum, b.edge_evaluations, "{algorithm}");
+        checked += 1;
+    }
+    assert_eq!(checked, 2);
 }
 
 /// Every packet size of the ray caster (one, four or sixteen 4×4 groups of
