@@ -70,7 +70,7 @@ fn set_up_in_lanes<'a>(
     flattened(blocks.unzip(), ids.len(), shared)
 }
 
-/// What a perspective setup in lanes ([`setup_3d_block`]) reads: the mesh's
+/// What a setup in lanes ([`setup_3d_block`]) reads: the mesh's
 /// positions and vertex records (`[u32; 3]` per triangle) as flat arrays
 /// the lanes gather from, the vertices' projections, the view.
 struct LaneMesh<'a> {
@@ -82,14 +82,11 @@ struct LaneMesh<'a> {
 }
 
 impl<'a> LaneMesh<'a> {
-    /// Whether the lanes apply: a planar perspective view, and a mesh small
-    /// enough for 32-bit lane offsets into its flat arrays.
+    /// Whether the lanes apply: a planar view, and a mesh small enough for
+    /// 32-bit lane offsets into its flat arrays.
     fn applies(view: &View, positions: &[Vec3], records: &[[u32; 3]]) -> bool {
         let fits = |n: usize| n < (i32::MAX / 4) as usize;
-        view.sphere.is_none()
-            && !view.is_orthographic()
-            && fits(positions.len())
-            && fits(records.len())
+        view.sphere.is_none() && fits(positions.len()) && fits(records.len())
     }
 
     fn new(

@@ -22,13 +22,13 @@ impl Triangle3D {
     /// The triangles of `t` set up for `view`, each exactly as
     /// [`Triangle3D::setup`] sets it up.
     pub(crate) fn setup_eight(t: &EightTriangles, view: &View) -> [Option<Triangle3D>; 8] {
-        setup_eight_with(t.corners, t.present, view, perspective_lanes)
+        setup_eight_with(t.corners, t.present, view, planar_lanes)
     }
 
-    /// [`Triangle3D::setup_eight`] of perspective triangles whose corners
-    /// are in lanes already (per vertex, per axis), for the lanes of
-    /// `present`; `corners(l)` gives lane `l`'s corners to the scalar setup
-    /// where the lanes cannot decide.
+    /// [`Triangle3D::setup_eight`] of triangles whose corners are in lanes
+    /// already (per vertex, per axis), for the lanes of `present`;
+    /// `corners(l)` gives lane `l`'s corners to the scalar setup where the
+    /// lanes cannot decide.
     #[inline(always)]
     pub(crate) fn setup_lanes<L: Lanes>(
         c: &[[L; 3]; 3],
@@ -36,9 +36,8 @@ impl Triangle3D {
         view: &View,
         corners: impl Fn(usize) -> [Vec3; 3],
     ) -> [Option<Triangle3D>; 8] {
-        debug_assert!(!view.is_orthographic());
         let [c0, c1, c2] = [V::of(c[0]), V::of(c[1]), V::of(c[2])];
-        let s = perspective_of(c0, c1, c2, view);
+        let s = planar_of(c0, c1, c2, view);
         assembled(present, &s, |l| Triangle3D::setup(&corners(l), view))
     }
 
@@ -83,7 +82,7 @@ fn homogeneous_eight_with(
 /// Vertex, axis, lane.
 type Corners = [[[f32; 8]; 3]; 3];
 
-/// [`setup_eight`] with the perspective lanes computed by `kernel`.
+/// [`setup_eight`] with the lanes computed by `kernel`.
 #[inline(always)]
 fn setup_eight_with(
     p: [&[Vec3; 3]; 8],
@@ -95,13 +94,6 @@ fn setup_eight_with(
     // eight at once with no box skip the kernel.
     if present == 0 {
         return [None; 8];
-    }
-    if view.is_orthographic() {
-        return std::array::from_fn(|l| {
-            (present >> l & 1 == 1)
-                .then(|| Triangle3D::setup(p[l], view))
-                .flatten()
-        });
     }
     // Absent lanes stay at zero: degenerate, undecided.
     let mut corners: Corners = [[[0.0; 8]; 3]; 3];
@@ -169,8 +161,8 @@ struct LaneSetups {
 }
 
 simd::dispatch! {
-    /// [`perspective_lanes_on`] on the lanes of this CPU.
-    fn perspective_lanes<>(corners: &Corners, view: &View) -> LaneSetups => perspective_lanes_on
+    /// [`planar_lanes_on`] on the lanes of this CPU.
+    fn planar_lanes<>(corners: &Corners, view: &View) -> LaneSetups => planar_lanes_on
 }
 
 /// Three lanes of coordinates: eight points or vectors.
@@ -186,6 +178,10 @@ impl<L: Lanes> V<L> {
     #[inline(always)]
     fn of([x, y, z]: [L; 3]) -> V<L> {
         V { x, y, z }
+    }
+    #[inline(always)]
+    fn splat(v: Vec3) -> V<L> {
+        V::of([L::splat(v.x), L::splat(v.y), L::splat(v.z)])
     }
     #[inline(always)]
     fn load(c: &[[f32; 8]; 3]) -> V<L> {
@@ -310,26 +306,32 @@ fn edge_lanes<L: Lanes>(a: V<L>, b: V<L>, sign: L, d_abs: Vec3, view: &View) -> 
     (m.cross(u).scale(sign).along(view), error)
 }
 
-/// The lanes of [`Triangle3D::setup`]'s perspective branch, step for step.
+/// The lanes of [`Triangle3D::setup`], step for step: its perspective
+/// branch or its orthographic one.
 #[inline(always)]
-fn perspective_lanes_on<L: Lanes>(corners: &Corners, view: &View) -> LaneSetups {
+fn planar_lanes_on<L: Lanes>(corners: &Corners, view: &View) -> LaneSetups {
     let [c0, c1, c2] = [
         V::load(&corners[0]),
         V::load(&corners[1]),
         V::load(&corners[2]),
     ];
-    perspective_of::<L>(c0, c1, c2, view)
+    planar_of::<L>(c0, c1, c2, view)
 }
 
-/// [`perspective_lanes_on`] of corners in lanes.
+/// [`planar_lanes_on`] of corners in lanes.
+#[inline(always)]
+fn planar_of<L: Lanes>(c0: V<L>, c1: V<L>, c2: V<L>, view: &View) -> LaneSetups {
+    match view.is_orthographic() {
+        true => orthographic_of(c0, c1, c2, view),
+        false => perspective_of(c0, c1, c2, view),
+    }
+}
+
+/// The perspective branch of [`planar_of`].
 #[inline(always)]
 fn perspective_of<L: Lanes>(c0: V<L>, c1: V<L>, c2: V<L>, view: &View) -> LaneSetups {
     // 1. Vertices relative to the eye, and their view-axis distances.
-    let eye = V {
-        x: L::splat(view.eye.x),
-        y: L::splat(view.eye.y),
-        z: L::splat(view.eye.z),
-    };
+    let eye = V::splat(view.eye);
     let (c0, c1, c2) = (c0.sub(eye), c1.sub(eye), c2.sub(eye));
     let w = [
         c0.dot_with(view.forward),
@@ -348,6 +350,67 @@ fn perspective_of<L: Lanes>(c0: V<L>, c1: V<L>, c2: V<L>, view: &View) -> LaneSe
     ];
     let nd = o.normal.scale(o.sign).along(view);
     finished(edges, nd, w, &o, extent)
+}
+
+/// The orthographic branch of [`planar_of`]: `Triangle3D::setup_orthographic`
+/// (paper §3.3) step for step, on the lanes whose vertices it leaves
+/// unscaled (where a scale of 1 changes none of its values).
+#[inline(always)]
+fn orthographic_of<L: Lanes>(c0: V<L>, c1: V<L>, c2: V<L>, view: &View) -> LaneSetups {
+    // 1. Vertices relative to the eye, and their view-axis distances.
+    let eye = V::splat(view.eye);
+    let (c0, c1, c2) = (c0.sub(eye), c1.sub(eye), c2.sub(eye));
+    let dp = view.forward;
+    let w = [c0.dot_with(dp), c1.dot_with(dp), c2.dot_with(dp)];
+    // 2. The facing N·d_p and its certain signs.
+    let (e1, e2) = (c1.sub(c0), c2.sub(c0));
+    let normal = e1.cross(e2);
+    let facing = normal.dot_with(dp);
+    let bound = L::splat(16.0 * EPS) * e1.abs_cross(e2).dot_with(dp.abs());
+    let o = Orientation::decided(normal, facing, bound, unscaled(c0, c1, c2));
+    // 3. The edges, `d_p × (a − b)` through the midpoint, and their errors.
+    let extent = image_extent(view);
+    let o_abs = view.o0.abs() + view.ox.abs() * extent.0 + view.oy.abs() * extent.1;
+    let edges = [
+        parallel_edge(c1, c2, o.sign, o_abs, view),
+        parallel_edge(c2, c0, o.sign, o_abs, view),
+        parallel_edge(c0, c1, o.sign, o_abs, view),
+    ];
+    let volume = toward(normal.scale(o.sign), c0, view);
+    finished(edges, volume, w, &o, extent)
+}
+
+/// `k·(q − o(x, y))` as a linear function of the image point:
+/// `[k·(q − o0), −k·ox, −k·oy]`.
+#[inline(always)]
+fn toward<L: Lanes>(k: V<L>, q: V<L>, view: &View) -> [L; 3] {
+    let minus = L::splat(-1.0);
+    [
+        k.dot(q.sub(V::splat(view.o0))),
+        k.dot_with(view.ox) * minus,
+        k.dot_with(view.oy) * minus,
+    ]
+}
+
+/// The orthographic edge function of edge `(a, b)`, `(d_p × (a − b))·(m − o)`
+/// through the midpoint `m`, oriented by `sign`, and its coefficient error
+/// bound: 8ε of `|d_p| ⊗ |a − b|` along `|m| + o_abs`.
+#[inline(always)]
+fn parallel_edge<L: Lanes>(a: V<L>, b: V<L>, sign: L, o_abs: Vec3, view: &View) -> ([L; 3], L) {
+    let dp = V::splat(view.forward);
+    let (u, m) = (a.sub(b), a.add(b).scale(L::splat(0.5)));
+    let error = L::splat(8.0 * EPS) * dp.abs_cross(u).dot(m.abs().add(V::splat(o_abs)));
+    (toward(dp.cross(u).scale(sign), m, view), error)
+}
+
+/// The lanes whose vertices `scaled` leaves as they are (no coordinate
+/// beyond [`SCALE_ABOVE`]); the others are the scalar setup's.
+#[inline(always)]
+fn unscaled<L: Lanes>(v0: V<L>, v1: V<L>, v2: V<L>) -> u8 {
+    let largest = (v0.abs().max_element())
+        .max(v1.abs().max_element())
+        .max(v2.abs().max_element());
+    largest.le(L::splat(SCALE_ABOVE))
 }
 
 simd::dispatch! {
@@ -397,15 +460,18 @@ struct Orientation<L> {
 impl<L: Lanes> Orientation<L> {
     #[inline(always)]
     fn of(v0: V<L>, v1: V<L>, v2: V<L>) -> Orientation<L> {
-        // Lanes that `scaled` would scale are left to the scalar setup.
-        let largest = (v0.abs().max_element())
-            .max(v1.abs().max_element())
-            .max(v2.abs().max_element());
-        let unscaled = largest.le(L::splat(SCALE_ABOVE));
         let (e1, e2) = (v1.sub(v0), v2.sub(v0));
         let normal = e1.cross(e2);
         let d = normal.dot(v0);
         let bound = L::splat(16.0 * EPS) * e1.abs_cross(e2).dot(v0.abs());
+        Orientation::decided(normal, d, bound, unscaled(v0, v1, v2))
+    }
+
+    /// The orientation by the sign of `d` where `bound` (its f32 error)
+    /// makes it certain, in the lanes of `unscaled` (`orientation` of
+    /// [`super::edge3d`]); `volume` is `|d|`.
+    #[inline(always)]
+    fn decided(normal: V<L>, d: L, bound: L, unscaled: u8) -> Orientation<L> {
         let positive = d.gt(bound);
         let negative = d.lt(L::splat(0.0) - bound);
         Orientation {
@@ -496,18 +562,21 @@ mod tests {
             near: Some(0.05),
         };
         let far = Vec3::new(3.0e5, 1.0e5, -2.0e5);
-        [
-            camera(Vec3::new(0.3, -0.2, 4.0), Vec3::new(0.0, 0.1, 0.0)),
-            camera(far, far + Vec3::new(0.1, 0.2, 1.0)),
-        ]
-        .iter()
-        .map(|c| View::new(c, 64, 48, 0.01).unwrap())
-        .collect()
+        let near = camera(Vec3::new(0.3, -0.2, 4.0), Vec3::new(0.0, 0.1, 0.0));
+        let far = camera(far, far + Vec3::new(0.1, 0.2, 1.0));
+        let parallel = |c: &Camera, height| Camera {
+            viewport: Viewport::Orthographic { height },
+            ..c.clone()
+        };
+        [parallel(&near, 3.0), parallel(&far, 40.0), near, far]
+            .iter()
+            .map(|c| View::new(c, 64, 48, 0.01).unwrap())
+            .collect()
     }
 
     /// Triangles of every kind the setup branches on: ordinary, tiny, huge,
-    /// beyond scaling, edge-on (the eye in their plane), degenerate, and
-    /// neighbours across a shared edge.
+    /// beyond scaling, edge-on (the eye, or the view axis, in their plane),
+    /// degenerate, and neighbours across a shared edge.
     fn triangles(view: &View, rng: &mut fastrand::Rng) -> Vec<[Vec3; 3]> {
         let mut out = Vec::new();
         let mut unit = || Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, rng.f32() - 0.5);
@@ -521,7 +590,10 @@ mod tests {
             );
             out.extend([
                 [a, b, c],
-                [a, b, view.eye + (a - view.eye) * 2.0],
+                match view.is_orthographic() {
+                    true => [a, b, a + view.forward * size],
+                    false => [a, b, view.eye + (a - view.eye) * 2.0],
+                },
                 [a, a, c],
                 [b, a, c + (b - a) * 0.5],
             ]);
@@ -538,8 +610,9 @@ mod tests {
     /// on all lanes or some.
     fn lanes_set_up_as_the_scalar_setup(kernel: fn(&Corners, &View) -> LaneSetups) {
         let mut rng = fastrand::Rng::with_seed(11);
-        let mut in_lanes = 0;
+        let mut per_view = Vec::new();
         for view in views() {
+            let mut in_lanes = 0;
             let tris = triangles(&view, &mut rng);
             for (k, chunk) in tris.chunks(8).enumerate() {
                 let present = if k % 3 == 0 { 0b1011_0110 } else { 0xff };
@@ -572,10 +645,16 @@ mod tests {
                 );
                 in_lanes += s.decided.count_ones();
             }
+            per_view.push(in_lanes);
         }
         // Half the cases are edge-on or degenerate and a fifth of the rest
-        // are scaled (the scalar fallback's); most others take the lanes.
-        assert!(in_lanes > 8_000, "{in_lanes} set up in lanes");
+        // are scaled (the scalar fallback's); most others take the lanes,
+        // in every view (orthographic ones first).
+        assert_eq!(per_view.len(), 4);
+        assert!(
+            per_view.iter().all(|&n| n > 3_000),
+            "{per_view:?} set up in lanes"
+        );
     }
 
     /// Every lane of `kernel`'s eight-at-once homogeneous setup equals the
@@ -618,7 +697,7 @@ mod tests {
                 }
             }
         }
-        assert_eq!(checked, 2 * 2 * 16_000);
+        assert_eq!(checked, 4 * 2 * 16_000);
         assert!(set_up > 16_000, "{set_up} set up");
     }
 
@@ -645,13 +724,13 @@ mod tests {
 
     #[test]
     fn portable_lanes_set_up_as_the_scalar_setup() {
-        lanes_set_up_as_the_scalar_setup(perspective_lanes_on::<simd::Portable>);
+        lanes_set_up_as_the_scalar_setup(planar_lanes_on::<simd::Portable>);
     }
 
     #[test]
     fn avx2_lanes_set_up_as_the_scalar_setup() {
         require_avx2();
-        // `perspective_lanes` takes AVX2 where the CPU has it.
-        lanes_set_up_as_the_scalar_setup(perspective_lanes);
+        // `planar_lanes` takes AVX2 where the CPU has it.
+        lanes_set_up_as_the_scalar_setup(planar_lanes);
     }
 }
