@@ -10,10 +10,9 @@ use crate::viewport::Viewport;
 /// Oracle settings a request puts on top of its algorithm's (paper §5, Fig. 7),
 /// in the CLI's words `key=value,…`: `outside`, `occluded`, `final_depth`,
 /// `binning`, `early_z`, `incremental` (`on`/`off`), `split` (`off` or a size
-/// in pixels),
-/// `frustum` and `leaf` (sizes in pixels), and `raycast`'s `packet` (the
-/// side in pixels of the block whose rays walk the BVH together: 4, 8 or
-/// 16). `None` keeps the algorithm's own.
+/// in pixels), `frustum` and `leaf` (sizes in pixels), and `raycast`'s
+/// `packet` (the side in pixels of the block whose rays walk the BVH
+/// together: 4, 8 or 16). `None` keeps the algorithm's own.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Oracles {
     pub outside: Option<bool>,
