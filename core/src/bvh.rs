@@ -191,9 +191,9 @@ impl SceneBvh {
     /// orthographic ones) against its own largest culling distance: one
     /// 8-lane test per node and group. So a packet whose groups diverge (one
     /// done behind a near surface, another still open to the background)
-    /// culls as its groups would alone. `leaf(slot, cull)` is called for each primitive slot of
-    /// every leaf the packet reaches, updates each lane's culling distance in
-    /// `cull[group]` and says whether it changed any. Returns the number of
+    /// culls as its groups would alone. `leaf(slot, cull)` is called for each
+    /// primitive slot of every leaf the packet reaches, updates each lane's
+    /// culling distance in `cull[group]` and says whether it changed any. Returns the number of
     /// nodes whose children were tested (once per node, for the packet), and
     /// adds their indices to `entered` when given (a render's trace). The slab
     /// tests run on lanes `L` (the caller's instruction set, see
@@ -469,13 +469,13 @@ impl PacketInterval {
         directions: &[[f32; PACKET]; 3],
         present: u16,
     ) -> PacketInterval {
-        let origin = |l: usize| lane_vector(origins, l);
-        let first = origin(present.trailing_zeros() as usize);
+        let first = lane_vector(origins, present.trailing_zeros() as usize);
         let (lo, hi) = padded_origin(first);
         let (mut origin_lo, mut origin_hi, mut one_origin) = ([lo; 2], [hi; 2], true);
         for l in (0..PACKET).filter(|&l| present >> l & 1 == 1) {
-            let (lo, hi) = padded_origin(origin(l));
-            one_origin &= origin(l) == first;
+            let origin = lane_vector(origins, l);
+            let (lo, hi) = padded_origin(origin);
+            one_origin &= origin == first;
             for a in 0..3 {
                 origin_lo[0][a] = origin_lo[0][a].min(lo[a]);
                 origin_lo[1][a] = origin_lo[1][a].max(lo[a]);
@@ -536,24 +536,30 @@ impl PacketInterval {
     /// not a closure: only `#[inline(always)]` code is compiled for the caller's lanes.)
     #[inline(always)]
     fn axis<L: Lanes>(&self, boxes: &Children<L>, a: usize) -> (L, L) {
+        // The distances at the least origins (the largest differences) ...
+        let (near, far) = self.distances(boxes, a, 0);
+        if self.one_origin {
+            return (near, far);
+        }
+        // ... and at the greatest (the smallest).
+        let (near_1, far_1) = self.distances(boxes, a, 1);
+        (near.min(near_1), far.max(far_1))
+    }
+
+    /// Along axis `a`, per child: the least and greatest of the box sides'
+    /// differences from origin end `end` (0: least, 1: greatest) times the
+    /// two reciprocal extremes.
+    #[inline(always)]
+    fn distances<L: Lanes>(&self, boxes: &Children<L>, a: usize, end: usize) -> (L, L) {
         let (lo, hi) = (L::splat(self.inv_min[a]), L::splat(self.inv_max[a]));
-        // The differences at the least origins (the largest differences) ...
-        let below = boxes.lo[a] - L::splat(self.origin_lo[0][a]);
-        let above = boxes.hi[a] - L::splat(self.origin_hi[0][a]);
+        let below = boxes.lo[a] - L::splat(self.origin_lo[end][a]);
+        let above = boxes.hi[a] - L::splat(self.origin_hi[end][a]);
         let (ta_lo, ta_hi) = (below * lo, below * hi);
         let (tb_lo, tb_hi) = (above * lo, above * hi);
-        let mut near = ta_lo.min(ta_hi).min(tb_lo.min(tb_hi));
-        let mut far = ta_lo.max(ta_hi).max(tb_lo.max(tb_hi));
-        if !self.one_origin {
-            // ... and at the greatest (the smallest).
-            let below = boxes.lo[a] - L::splat(self.origin_lo[1][a]);
-            let above = boxes.hi[a] - L::splat(self.origin_hi[1][a]);
-            let (ta_lo, ta_hi) = (below * lo, below * hi);
-            let (tb_lo, tb_hi) = (above * lo, above * hi);
-            near = near.min(ta_lo.min(ta_hi).min(tb_lo.min(tb_hi)));
-            far = far.max(ta_lo.max(ta_hi).max(tb_lo.max(tb_hi)));
-        }
-        (near, far)
+        (
+            ta_lo.min(ta_hi).min(tb_lo.min(tb_hi)),
+            ta_lo.max(ta_hi).max(tb_lo.max(tb_hi)),
+        )
     }
 }
 

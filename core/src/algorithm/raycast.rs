@@ -40,6 +40,12 @@ const LANE_Y: [[f32; 8]; HALVES] = [
     [2.0, 2.0, 2.0, 2.0, 3.0, 3.0, 3.0, 3.0],
 ];
 
+/// The pixel of lane `l` of the group at `corner`: `corner + (l % 4, l / 4)`.
+#[inline(always)]
+fn lane_pixel((x, y): (u32, u32), l: usize) -> (u32, u32) {
+    (x + l as u32 % BLOCK, y + l as u32 / BLOCK)
+}
+
 /// Casts one ray per stored sample; `setup` gives the same triangles the 3D
 /// rasterizers of this viewport use. Under CSAA the coverage-only positions are
 /// decided as the rasterizers decide them: each triangle a stored ray found is
@@ -247,9 +253,7 @@ fn cast_band_on<L: Lanes, T: Stored, const G: usize>(
                                 let (w, lane) = (depth[l], half * 8 + l);
                                 covered[g][lane] += 1;
                                 if see_through {
-                                    let (px, py) = (corner[g].0, corner[g].1);
-                                    let (px, py) =
-                                        (px + lane as u32 % BLOCK, py + lane as u32 / BLOCK);
+                                    let (px, py) = lane_pixel(corner[g], lane);
                                     let i = (py - y0) as usize * width + (px - x0) as usize;
                                     fragments.push(Fragment {
                                         sample: (s * pixels + i) as u32,
@@ -314,10 +318,7 @@ fn cast_band_on<L: Lanes, T: Stored, const G: usize>(
                 for g in 0..G {
                     for (l, slots) in slots[g].iter().enumerate() {
                         if inside_tile[g] >> l & 1 == 1 {
-                            let p = (
-                                corner[g].0 + l as u32 % BLOCK,
-                                corner[g].1 + l as u32 / BLOCK,
-                            );
+                            let p = lane_pixel(corner[g], l);
                             stored_masks::<L, T>(setups, slots, tile, p);
                             nodes += lost_coverage::<T>(scene, view, setups, tile, p);
                         }
