@@ -126,6 +126,26 @@ impl<T: Stored> Setups<'_, T> {
     }
 }
 
+/// The tiles of an image, row by row.
+struct TileGrid {
+    columns: usize,
+}
+
+impl TileGrid {
+    /// Calls `f` with the index of every tile that the non-empty `r` reaches.
+    #[inline(always)]
+    fn each(&self, r: &PixelRect, mut f: impl FnMut(usize)) {
+        let (tx0, tx1) = (r.x0 / TILE_WIDTH, (r.x1 - 1) / TILE_WIDTH);
+        let (ty0, ty1) = (r.y0 / TILE_HEIGHT, (r.y1 - 1) / TILE_HEIGHT);
+        for ty in ty0..=ty1 {
+            let row = ty as usize * self.columns;
+            for tx in tx0..=tx1 {
+                f(row + tx as usize);
+            }
+        }
+    }
+}
+
 /// Renders `items` into `fb`, tile by tile in parallel (`None` items are
 /// triangles the setup dropped), each triangle within each tile by `kernel`
 /// (tile, triangle, id, the pixels of its box in the tile, counters).
@@ -135,15 +155,10 @@ pub(crate) fn rasterize_tiled<T: Stored>(
     context: &TileContext,
     kernel: impl Fn(&mut TileBuffer, &T::Bound<'_>, u32, PixelRect, &mut RasterCounters) + Sync,
 ) -> Pass {
-    let columns = fb.width.div_ceil(TILE_WIDTH) as usize;
-    let rows = fb.height.div_ceil(TILE_HEIGHT) as usize;
-    let tile_count = columns * rows;
-    let tiles_of = |r: &PixelRect| {
-        let (tx0, tx1) = (r.x0 / TILE_WIDTH, (r.x1 - 1) / TILE_WIDTH);
-        let (ty0, ty1) = (r.y0 / TILE_HEIGHT, (r.y1 - 1) / TILE_HEIGHT);
-        (ty0..=ty1)
-            .flat_map(move |ty| (tx0..=tx1).map(move |tx| ty as usize * columns + tx as usize))
+    let grid = TileGrid {
+        columns: fb.width.div_ceil(TILE_WIDTH) as usize,
     };
+    let tile_count = grid.columns * fb.height.div_ceil(TILE_HEIGHT) as usize;
 
     // 1. Counting sorts of item indices by tile, one per run of items, in
     // parallel: a tile's items are its lists of every run, in run order.
@@ -154,9 +169,7 @@ pub(crate) fn rasterize_tiled<T: Stored>(
             let base = (run * BIN_RUN) as u32;
             let mut offsets = vec![0u32; tile_count + 1];
             for (rect, _) in chunk.iter().filter_map(|b| b.get()) {
-                for t in tiles_of(&rect) {
-                    offsets[t + 1] += 1;
-                }
+                grid.each(&rect, |t| offsets[t + 1] += 1);
             }
             for t in 0..tile_count {
                 offsets[t + 1] += offsets[t];
@@ -167,10 +180,10 @@ pub(crate) fn rasterize_tiled<T: Stored>(
                 let Some((rect, _)) = item.get() else {
                     continue;
                 };
-                for t in tiles_of(&rect) {
+                grid.each(&rect, |t| {
                     members[fill[t] as usize] = base + k as u32;
                     fill[t] += 1;
-                }
+                });
             }
             Binned { offsets, members }
         })
@@ -180,9 +193,14 @@ pub(crate) fn rasterize_tiled<T: Stored>(
     // its worker (the samples never outlive their tile).
     let rects = fb.tile_rects(TILE_WIDTH, TILE_HEIGHT);
     let mut pass = Pass::default();
-    let done = context.run_tiles(&mut pass, fb, &rects, |t, (), tile| {
+    let done = context.run_tiles(&mut pass, fb, &rects, |t, members: &mut Vec<u32>, tile| {
         let mut counters = RasterCounters::default();
-        let members: Vec<u32> = runs.iter().flat_map(|run| run.of(t)).copied().collect();
+        // The tile's items, gathered into the worker's list (kept from tile
+        // to tile).
+        members.clear();
+        for run in &runs {
+            members.extend_from_slice(run.of(t));
+        }
         for (i, &k) in members.iter().enumerate() {
             // The records of an item a few places on are on their way while
             // this one is rasterized (they are far apart in memory, and a
