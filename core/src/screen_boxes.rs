@@ -742,6 +742,21 @@ impl PixelRects {
         })
     }
 
+    /// Every lane's pixel bounds `[x0, y0, x1, y1]` (`x1`, `y1` past the
+    /// last pixel), computed in lanes as [`PixelRects::get`] computes them
+    /// one by one (whole numbers below 2¹⁶: adding one and truncating are
+    /// exact); meaningful only for the lanes of `some`.
+    #[inline(always)]
+    pub(crate) fn bounds<L: Lanes>(&self) -> [[u32; 8]; 4] {
+        let one = L::splat(1.0);
+        [
+            L::from_array(self.first[0]).truncate(),
+            L::from_array(self.first[1]).truncate(),
+            (L::from_array(self.last[0]) + one).truncate(),
+            (L::from_array(self.last[1]) + one).truncate(),
+        ]
+    }
+
     /// Lane `l`'s rect becomes `rect` (pixel bounds are below 2¹⁶: exact in f32).
     #[inline(always)]
     fn set(&mut self, l: usize, rect: Option<PixelRect>) {

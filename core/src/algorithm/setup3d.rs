@@ -139,11 +139,12 @@ fn setup_3d_block_on<L: Lanes>(mesh: &LaneMesh, ids: &[u32], run: Option<u32>) -
             None => *EightIds::of(eight).get(),
         };
         let rects = rects_eight_lanes::<L>(mesh, items, eight.len());
+        let [x0, y0, x1, y1] = rects.bounds::<L>();
         let mut some = rects.some;
         while some != 0 {
             let l = some.trailing_zeros() as usize;
             some &= some - 1;
-            let rect = rects.get(l).expect("a lane of `some` has a rect");
+            let rect = PixelRect::new(x0[l], y0[l], x1[l], y1[l]);
             boxes[e * 8 + l] = ItemBox::new(rect, eight[l]);
             (packed[n], at[n]) = (items[l], e * 8 + l);
             n += 1;

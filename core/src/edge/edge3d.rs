@@ -106,13 +106,31 @@ impl Tolerances {
     /// largest such finite float it is infinite).
     #[inline(always)]
     pub(super) fn new(t: [f32; 3], negated: bool) -> Tolerances {
+        Tolerances(ALWAYS_SET | Tolerances::word(t, negated))
+    }
+
+    /// [`Tolerances::new`] of eight lanes (tolerances per edge and lane,
+    /// bit per lane negated): one loop over plain words, which compiles to
+    /// lanes.
+    #[inline(always)]
+    pub(super) fn eight(t: &[[f32; 8]; 3], negated: u8) -> [Tolerances; 8] {
+        let mut words = [0u32; 8];
+        for (l, word) in words.iter_mut().enumerate() {
+            let lane = [t[0][l], t[1][l], t[2][l]];
+            *word = Tolerances::word(lane, negated >> l & 1 == 1);
+        }
+        words.map(|word| Tolerances(ALWAYS_SET | word))
+    }
+
+    /// The word of [`Tolerances::new`] but for the bit always set.
+    #[inline(always)]
+    fn word(t: [f32; 3], negated: bool) -> u32 {
         let kept = |t: f32| {
             let bits = t.to_bits() & 0x7fff_ffff;
             let up = (bits >> DROPPED) + u32::from(bits & ((1 << DROPPED) - 1) != 0);
             up.min(f32::INFINITY.to_bits() >> DROPPED)
         };
-        let word = kept(t[0]) | kept(t[1]) << 10 | kept(t[2]) << 20 | u32::from(negated) << 30;
-        Tolerances(ALWAYS_SET | word)
+        kept(t[0]) | kept(t[1]) << 10 | kept(t[2]) << 20 | u32::from(negated) << 30
     }
 
     /// Edge `k`'s tolerance.

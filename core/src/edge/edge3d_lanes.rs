@@ -118,6 +118,7 @@ fn assembled(
     scalar: impl Fn(usize) -> Option<Triangle3D>,
 ) -> [Option<Triangle3D>; 8] {
     let mut out = [None; 8];
+    let tolerances = Tolerances::eight(&s.tolerance, s.negated);
     for (l, out) in out.iter_mut().enumerate() {
         if present >> l & 1 == 0 {
             continue;
@@ -135,10 +136,7 @@ fn assembled(
             varying: [s.nd[0][l], s.nd[1][l], s.nd[2][l]],
             constant: s.volume[l],
             w_range: [w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2])],
-            tolerance: Tolerances::new(
-                [0, 1, 2].map(|k| s.tolerance[k][l]),
-                s.negated >> l & 1 == 1,
-            ),
+            tolerance: tolerances[l],
         });
     }
     out
