@@ -193,9 +193,10 @@ impl SceneBvh {
     /// done behind a near surface, another still open to the background)
     /// culls as its groups would alone. `leaf(slot, cull)` is called for each
     /// primitive slot of every leaf the packet reaches, updates each lane's
-    /// culling distance in `cull[group]` and says whether it changed any. Returns the number of
-    /// nodes whose children were tested (once per node, for the packet), and
-    /// adds their indices to `entered` when given (a render's trace). The slab
+    /// culling distance in `cull[group]` and says whether it changed any.
+    /// Returns the number of nodes whose children were tested (once per
+    /// node, for the packet), and adds their indices to `entered` when given
+    /// (a render's trace). The slab
     /// tests run on lanes `L` (the caller's instruction set, see
     /// [`crate::simd`]; inlined into it).
     #[inline(always)]

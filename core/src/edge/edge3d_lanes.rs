@@ -316,26 +316,30 @@ fn planar_lanes_on<L: Lanes>(corners: &Corners, view: &View) -> LaneSetups {
     planar_of::<L>(c0, c1, c2, view)
 }
 
-/// [`planar_lanes_on`] of corners in lanes.
+/// [`planar_lanes_on`] of corners in lanes: the vertices relative to the
+/// eye and their view-axis distances `w` (both branches' first step), then
+/// the branch.
 #[inline(always)]
 fn planar_of<L: Lanes>(c0: V<L>, c1: V<L>, c2: V<L>, view: &View) -> LaneSetups {
+    let eye = V::splat(view.eye);
+    let c = [c0.sub(eye), c1.sub(eye), c2.sub(eye)];
+    // (No closure around a lane operation: it would be compiled without the
+    // lanes' instruction set.)
+    let w = [
+        c[0].dot_with(view.forward),
+        c[1].dot_with(view.forward),
+        c[2].dot_with(view.forward),
+    ];
     match view.is_orthographic() {
-        true => orthographic_of(c0, c1, c2, view),
-        false => perspective_of(c0, c1, c2, view),
+        true => orthographic_of(c, w, view),
+        false => perspective_of(c, w, view),
     }
 }
 
-/// The perspective branch of [`planar_of`].
+/// The perspective branch of [`planar_of`], on eye-relative vertices `c`
+/// with view-axis distances `w`.
 #[inline(always)]
-fn perspective_of<L: Lanes>(c0: V<L>, c1: V<L>, c2: V<L>, view: &View) -> LaneSetups {
-    // 1. Vertices relative to the eye, and their view-axis distances.
-    let eye = V::splat(view.eye);
-    let (c0, c1, c2) = (c0.sub(eye), c1.sub(eye), c2.sub(eye));
-    let w = [
-        c0.dot_with(view.forward),
-        c1.dot_with(view.forward),
-        c2.dot_with(view.forward),
-    ];
+fn perspective_of<L: Lanes>([c0, c1, c2]: [V<L>; 3], w: [L; 3], view: &View) -> LaneSetups {
     // 2. The volume D = N·c0 and its certain signs.
     let o = Orientation::of(c0, c1, c2);
     // 3. The three edges (edge i opposite vertex i) and their errors.
@@ -352,14 +356,11 @@ fn perspective_of<L: Lanes>(c0: V<L>, c1: V<L>, c2: V<L>, view: &View) -> LaneSe
 
 /// The orthographic branch of [`planar_of`]: `Triangle3D::setup_orthographic`
 /// (paper §3.3) step for step, on the lanes whose vertices it leaves
-/// unscaled (where a scale of 1 changes none of its values).
+/// unscaled (where a scale of 1 changes none of its values); eye-relative
+/// vertices `c` with view-axis distances `w`.
 #[inline(always)]
-fn orthographic_of<L: Lanes>(c0: V<L>, c1: V<L>, c2: V<L>, view: &View) -> LaneSetups {
-    // 1. Vertices relative to the eye, and their view-axis distances.
-    let eye = V::splat(view.eye);
-    let (c0, c1, c2) = (c0.sub(eye), c1.sub(eye), c2.sub(eye));
+fn orthographic_of<L: Lanes>([c0, c1, c2]: [V<L>; 3], w: [L; 3], view: &View) -> LaneSetups {
     let dp = view.forward;
-    let w = [c0.dot_with(dp), c1.dot_with(dp), c2.dot_with(dp)];
     // 2. The facing N·d_p and its certain signs.
     let (e1, e2) = (c1.sub(c0), c2.sub(c0));
     let normal = e1.cross(e2);
