@@ -10,7 +10,10 @@
 //! stored) skip the hierarchy and are tested on those samples directly, in one
 //! group of lanes across rows, as llvmpipe's and Nanite's small-triangle paths
 //! do: the same sample points through the same [`Coverage`] decision, so the
-//! same image bit for bit; the counters record the tests actually made.
+//! same image bit for bit; the counters record the tests actually made. A tile
+//! loop whose coverage type tests across triangles may instead queue those
+//! samples and test eight of them at a time, each against its own triangle
+//! ([`SmallQueue`]).
 
 use crate::edge::{BlockTest, Coverage, RowLanes};
 use crate::framebuffer::{SCRATCH_PIXELS, TileBuffer};
@@ -242,6 +245,112 @@ fn sample_small<L: Lanes, T: Coverage>(
         tile.write(at[l], w[l], id);
     }
     mask.count_ones()
+}
+
+/// Samples of small triangles waiting to be tested eight at a time, each
+/// lane against its own triangle ([`Coverage::sample_across`]): the
+/// small-triangle path of a tile that renders many triangles of a few
+/// samples each (a mesh of sub-pixel triangles averages under three), where
+/// [`sample_small`] would fill a group of lanes with one triangle's few
+/// samples. Each triangle's box is one [`sample_small`] would take
+/// ([`SmallQueue::takes`]); its samples are queued in the order that path
+/// forms them, at the same points, their tests counted as it counts them.
+/// Writes then come later than in input order, which changes no buffer: the
+/// depth test keeps the nearest sample and, at equal depth, the smaller id,
+/// whatever the order — so the queue is only for opaque triangles
+/// ([`SmallQueue::applies`]).
+#[derive(Debug)]
+pub(crate) struct SmallQueue<B> {
+    /// Each lane's triangle (spare lanes: an earlier one, not tested).
+    tris: [B; 8],
+    x: [f32; 8],
+    y: [f32; 8],
+    /// Each lane's stored sample and triangle id.
+    at: [u32; 8],
+    ids: [u32; 8],
+    n: usize,
+}
+
+impl<B: Coverage + Copy> SmallQueue<B> {
+    /// Whether the queue may take `tile`'s small triangles: every triangle
+    /// opaque, and no trace recorded.
+    pub(crate) fn applies(tile: &TileBuffer) -> bool {
+        tile.opacity.is_empty() && tile.trace.is_none()
+    }
+
+    /// Does the box `r` in `tile` take the small-triangle path?
+    #[inline(always)]
+    pub(crate) fn takes(tile: &TileBuffer, r: PixelRect) -> bool {
+        is_small(tile, r)
+    }
+
+    /// An empty queue (`tri` fills its lanes until samples do).
+    pub(crate) fn new(tri: B) -> SmallQueue<B> {
+        SmallQueue {
+            tris: [tri; 8],
+            x: [0.0; 8],
+            y: [0.0; 8],
+            at: [0; 8],
+            ids: [0; 8],
+            n: 0,
+        }
+    }
+
+    /// Queues the samples of `r` (a box [`SmallQueue::takes`]) of `tri`,
+    /// triangle `id`, and counts their tests; tests them whenever eight are
+    /// queued.
+    #[inline(always)]
+    pub(crate) fn push(&mut self, tile: &mut TileBuffer, tri: B, id: u32, r: PixelRect) {
+        let pattern = tile.pattern;
+        let count = pattern.positions.len() as u32;
+        // The queue's length in a local, below eight where lanes are written.
+        let mut n = self.n;
+        for y in r.y0..r.y1 {
+            let i = tile.index(r.x0, y);
+            for (k, x) in (r.x0..r.x1).enumerate() {
+                tile.edge_evals[i + k] += count;
+                for (c, [ox, oy]) in pattern.positions.iter().enumerate() {
+                    if n >= 8 {
+                        self.n = n;
+                        self.flush(tile);
+                        n = 0;
+                    }
+                    (self.x[n], self.y[n]) = (x as f32 + ox, y as f32 + oy);
+                    self.at[n] = (c * tile.pixels + i + k) as u32;
+                    (self.tris[n], self.ids[n]) = (tri, id);
+                    n += 1;
+                }
+            }
+        }
+        self.n = n;
+    }
+
+    /// Tests the queued samples (if any) and writes the covered ones.
+    #[inline(always)]
+    pub(crate) fn flush(&mut self, tile: &mut TileBuffer) {
+        if self.n > 0 {
+            test_across(tile, self);
+            self.n = 0;
+        }
+    }
+}
+
+simd::dispatch! {
+    /// The queued samples of `queue`, lane `l` against its triangle,
+    /// written where covered.
+    fn test_across<B: Coverage>(tile: &mut TileBuffer, queue: &SmallQueue<B>) -> ()
+        => test_across_on
+}
+
+#[inline(always)]
+fn test_across_on<L: Lanes, B: Coverage>(tile: &mut TileBuffer, q: &SmallQueue<B>) {
+    let (mask, w) = B::sample_across::<L>(&q.tris, q.x, q.y, first_lanes(q.n));
+    let mut covered = mask;
+    while covered != 0 {
+        let l = covered.trailing_zeros() as usize;
+        covered &= covered - 1;
+        tile.write(q.at[l] as usize, w[l], q.ids[l]);
+    }
 }
 
 /// The narrowest block found inside that [`fill_samples`] walks through the

@@ -91,6 +91,11 @@ mod sealed {
         /// in lane `l` of field `k`; panics, as indexing does, when an
         /// index is out of bounds.
         fn gather_xyzw(base: &[[f32; 4]], index: [u32; 8]) -> [Self; 4];
+        /// Eight rows as lanes: lane `l` of field `k` is `rows[l][k]`.
+        fn transpose(rows: [[f32; 8]; 8]) -> [Self; 8];
+        /// Each lane's bits `shift..shift + width` moved up to `up..`, the
+        /// other bits cleared: `(bits >> shift & (2^width − 1)) << up`.
+        fn bit_field(self, shift: u32, width: u32, up: u32) -> Self;
     }
 }
 
@@ -174,6 +179,15 @@ impl sealed::Ops for Portable {
     fn gather_xyzw(base: &[[f32; 4]], index: [u32; 8]) -> [Self; 4] {
         let rows = index.map(|i| base[i as usize]);
         [0, 1, 2, 3].map(|k| Self::from_array(rows.map(|r| r[k])))
+    }
+    #[inline(always)]
+    fn transpose(rows: [[f32; 8]; 8]) -> [Self; 8] {
+        std::array::from_fn(|k| Self::from_array(rows.map(|r| r[k])))
+    }
+    #[inline(always)]
+    fn bit_field(self, shift: u32, width: u32, up: u32) -> Self {
+        let field = |v: f32| f32::from_bits((v.to_bits() >> shift & ((1 << width) - 1)) << up);
+        Self::from_array(self.to_array().map(field))
     }
 }
 
@@ -355,6 +369,60 @@ mod avx2_lanes {
             // SAFETY: every index is below `base.len()`, so the four floats
             // of row `index[l]`, from float `4·index[l]`, lie in `base`.
             unsafe { transposed(base.as_flattened().as_ptr(), index, 4) }
+        }
+        #[inline(always)]
+        fn transpose(rows: [[f32; 8]; 8]) -> [Self; 8] {
+            let r = rows.map(|row| Self::from_array(row).0);
+            // Straight-line intrinsics, no closures: a closure would not
+            // carry this function's target features, and each intrinsic
+            // would become a call.
+            avx!({
+                // Pairs of rows interleaved, then quads, then the halves.
+                let (t0, t1) = (
+                    _mm256_unpacklo_ps(r[0], r[1]),
+                    _mm256_unpackhi_ps(r[0], r[1]),
+                );
+                let (t2, t3) = (
+                    _mm256_unpacklo_ps(r[2], r[3]),
+                    _mm256_unpackhi_ps(r[2], r[3]),
+                );
+                let (t4, t5) = (
+                    _mm256_unpacklo_ps(r[4], r[5]),
+                    _mm256_unpackhi_ps(r[4], r[5]),
+                );
+                let (t6, t7) = (
+                    _mm256_unpacklo_ps(r[6], r[7]),
+                    _mm256_unpackhi_ps(r[6], r[7]),
+                );
+                let q0 = _mm256_shuffle_ps::<0x44>(t0, t2);
+                let q1 = _mm256_shuffle_ps::<0xee>(t0, t2);
+                let q2 = _mm256_shuffle_ps::<0x44>(t1, t3);
+                let q3 = _mm256_shuffle_ps::<0xee>(t1, t3);
+                let q4 = _mm256_shuffle_ps::<0x44>(t4, t6);
+                let q5 = _mm256_shuffle_ps::<0xee>(t4, t6);
+                let q6 = _mm256_shuffle_ps::<0x44>(t5, t7);
+                let q7 = _mm256_shuffle_ps::<0xee>(t5, t7);
+                [
+                    Avx2(_mm256_permute2f128_ps::<0x20>(q0, q4)),
+                    Avx2(_mm256_permute2f128_ps::<0x20>(q1, q5)),
+                    Avx2(_mm256_permute2f128_ps::<0x20>(q2, q6)),
+                    Avx2(_mm256_permute2f128_ps::<0x20>(q3, q7)),
+                    Avx2(_mm256_permute2f128_ps::<0x31>(q0, q4)),
+                    Avx2(_mm256_permute2f128_ps::<0x31>(q1, q5)),
+                    Avx2(_mm256_permute2f128_ps::<0x31>(q2, q6)),
+                    Avx2(_mm256_permute2f128_ps::<0x31>(q3, q7)),
+                ]
+            })
+        }
+        #[inline(always)]
+        fn bit_field(self, shift: u32, width: u32, up: u32) -> Self {
+            avx!({
+                let bits = _mm256_castps_si256(self.0);
+                let down = _mm256_srl_epi32(bits, _mm_cvtsi32_si128(shift as i32));
+                let kept = _mm256_and_si256(down, _mm256_set1_epi32(((1u32 << width) - 1) as i32));
+                let moved = _mm256_sll_epi32(kept, _mm_cvtsi32_si128(up as i32));
+                Avx2(_mm256_castsi256_ps(moved))
+            })
         }
     }
 

@@ -71,17 +71,19 @@ pub(crate) fn run(
             // or (`spans`, straight edges) by the sweep line of `scanline`.
             macro_rules! tiles {
                 ($items:expr, spans) => {
-                    tiles!($items, |tile, tri, id, clip, n| raster_spans(
+                    tiles!($items, false, |tile, tri, id, clip, n| raster_spans(
                         tile, tri, id, clip, n
                     ))
                 };
+                // Without early-z, a small box's samples are all the
+                // kernel does there.
                 ($items:expr) => {
-                    tiles!($items, |tile, tri, id, clip, n| {
+                    tiles!($items, !samples.early_z, |tile, tri, id, clip, n| {
                         raster_triangle(tile, tri, id, clip, samples, n)
                     })
                 };
-                ($items:expr, $kernel:expr) => {
-                    timed_tiles(&$items, fb, context, stats, start, $kernel)
+                ($items:expr, $small:expr, $kernel:expr) => {
+                    timed_tiles(&$items, fb, context, stats, start, $small, $kernel)
                 };
             }
             let fixed = precision == Precision::Fixed;
@@ -257,11 +259,12 @@ fn timed_tiles<T: Stored>(
     context: &TileContext,
     stats: &mut Stats,
     start: Instant,
+    small: bool,
     kernel: impl Fn(&mut TileBuffer, &T::Bound<'_>, u32, PixelRect, &mut RasterCounters) + Sync,
 ) -> Pass {
     stats.time_ms.setup = start.elapsed().as_secs_f64() * 1e3;
     let start = Instant::now();
-    let pass = rasterize_tiled(items, fb, context, kernel);
+    let pass = rasterize_tiled(items, fb, context, small, kernel);
     stats.triangle_setups = items.placed();
     let [coverage, resolve, shading] = pass.split(start);
     stats.time_ms.coverage = coverage;

@@ -6,7 +6,8 @@
 use rayon::prelude::*;
 
 use super::{Pass, PixelRect, TileContext};
-use crate::edge::Stored;
+use crate::binning::SmallQueue;
+use crate::edge::{Coverage, Stored};
 use crate::framebuffer::{Framebuffer, TileBuffer};
 use crate::simd;
 use crate::stats::RasterCounters;
@@ -149,10 +150,15 @@ impl TileGrid {
 /// Renders `items` into `fb`, tile by tile in parallel (`None` items are
 /// triangles the setup dropped), each triangle within each tile by `kernel`
 /// (tile, triangle, id, the pixels of its box in the tile, counters).
+/// `small`: the kernel tests a box that [`SmallQueue::takes`] sample by
+/// sample and does nothing else there (no early-z), so such boxes may go
+/// through a [`SmallQueue`] instead, where the coverage tests across
+/// triangles ([`Coverage::ACROSS`]).
 pub(crate) fn rasterize_tiled<T: Stored>(
     items: &Setups<T>,
     fb: &mut Framebuffer,
     context: &TileContext,
+    small: bool,
     kernel: impl Fn(&mut TileBuffer, &T::Bound<'_>, u32, PixelRect, &mut RasterCounters) + Sync,
 ) -> Pass {
     let grid = TileGrid {
@@ -201,6 +207,10 @@ pub(crate) fn rasterize_tiled<T: Stored>(
         for run in &runs {
             members.extend_from_slice(run.of(t));
         }
+        let across = small
+            && <T::Bound<'_> as Coverage>::ACROSS
+            && SmallQueue::<T::Bound<'_>>::applies(tile);
+        let mut queue = None;
         for (i, &k) in members.iter().enumerate() {
             // The records of an item a few places on are on their way while
             // this one is rasterized (they are far apart in memory, and a
@@ -215,8 +225,16 @@ pub(crate) fn rasterize_tiled<T: Stored>(
             };
             // Non-empty: the item was sorted into this tile by its rect.
             if let Some(clip) = rect.intersect(tile.rect()) {
-                kernel(tile, &tri, id, clip, &mut counters);
+                if across && SmallQueue::<T::Bound<'_>>::takes(tile, clip) {
+                    let queue = queue.get_or_insert_with(|| SmallQueue::new(tri));
+                    queue.push(tile, tri, id, clip);
+                } else {
+                    kernel(tile, &tri, id, clip, &mut counters);
+                }
             }
+        }
+        if let Some(queue) = &mut queue {
+            queue.flush(tile);
         }
         counters
     });

@@ -1030,6 +1030,87 @@ impl Coverage for Bound3D<'_> {
     fn min_depth(&self) -> f32 {
         self.t.w_range[0].max(self.shared.near)
     }
+
+    const ACROSS: bool = true;
+
+    /// [`Bound3D::sample_lanes`] with each lane's coefficients its own
+    /// triangle's ([`Triangle3D::words`], transposed into lanes): the same
+    /// operations in the same order per lane, so the same decisions and
+    /// depths.
+    #[inline(always)]
+    fn sample_across<L: Lanes>(
+        tris: &[Self; 8],
+        x: [f32; 8],
+        y: [f32; 8],
+        active: u8,
+    ) -> (u8, [f32; 8]) {
+        let shared = tris[0].shared;
+        let [a0, a1, a2, b0, b1, b2, c0, c1] = L::transpose(tris.map(|tri| tri.t.words()[0]));
+        let [c2, k0, k1, k2, constant, w_min, w_max, tolerance] =
+            L::transpose(tris.map(|tri| tri.t.words()[1]));
+        let (xs, ys) = (L::from_array(x), L::from_array(y));
+        let varying = k0 + xs * k1 + ys * k2;
+        let (facing, volume) = if shared.parallel {
+            (constant, varying)
+        } else {
+            (varying, constant)
+        };
+        let active = active & facing.gt(L::splat(0.0));
+        let (mut certain_in, mut certain_out) = (active, !active);
+        for (k, [a, b, c]) in [[a0, b0, c0], [a1, b1, c1], [a2, b2, c2]]
+            .into_iter()
+            .enumerate()
+        {
+            let e = a + xs * b + ys * c;
+            // Tolerances::get(k) per lane.
+            let t = tolerance.bit_field(10 * k as u32, 10, DROPPED);
+            certain_in &= e.gt(t);
+            certain_out |= e.lt(L::splat(0.0) - t);
+        }
+        let mut undecided = !(certain_in | certain_out);
+        let mut inside = certain_in;
+        while undecided != 0 {
+            let l = undecided.trailing_zeros() as usize;
+            undecided &= undecided - 1;
+            let tri = &tris[l];
+            if tri.inside(tri.t.edge_values(x[l], y[l]), x[l], y[l]) {
+                inside |= 1 << l;
+            }
+        }
+        if inside == 0 {
+            return (0, [0.0; 8]);
+        }
+        depth_in(
+            facing,
+            volume,
+            inside,
+            [w_min, w_max, L::splat(shared.near)],
+        )
+    }
+}
+
+impl Triangle3D {
+    /// The record as sixteen words in field order: `A`, `B`, `C`, the
+    /// varying depth, the constant, `w_range`, and the tolerance word's
+    /// bits as a float.
+    #[inline(always)]
+    fn words(&self) -> [[f32; 8]; 2] {
+        let (a, b, c, k) = (self.a, self.b, self.c, self.varying);
+        let tolerance = f32::from_bits(self.tolerance.0.get());
+        [
+            [a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1]],
+            [
+                c[2],
+                k[0],
+                k[1],
+                k[2],
+                self.constant,
+                self.w_range[0],
+                self.w_range[1],
+                tolerance,
+            ],
+        ]
+    }
 }
 
 /// A vertex in homogeneous pixel coordinates `(X, Y, W)`, `x = X/W`
@@ -1168,5 +1249,110 @@ mod tests {
             compared > 20_000,
             "only {compared} covered samples compared"
         );
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn across_avx2(tris: &[Bound3D; 8], x: [f32; 8], y: [f32; 8], active: u8) -> (u8, [f32; 8]) {
+        Bound3D::sample_across::<crate::simd::Avx2>(tris, x, y, active)
+    }
+
+    /// Eight samples each against its own triangle
+    /// ([`Coverage::sample_across`]) give each triangle's own decision and
+    /// depth ([`Coverage::sample`]) in the lanes asked for, on the portable
+    /// lanes and on AVX2, in perspective and in parallel projection: random
+    /// triangles near and through the eye plane, sample points on a quarter
+    /// pixel grid (some on edges and vertices, where the exact signs decide).
+    #[test]
+    fn samples_across_triangles_decide_as_each_alone() {
+        let mut rng = fastrand::Rng::with_seed(11);
+        // The second looks straight down the z axis, one unit to eight
+        // pixels: edges between grid vertices pass through sample points.
+        let viewports = [
+            (
+                Vec3::new(0.3, -0.2, 4.0),
+                crate::camera::Viewport::Perspective { fov_y_deg: 60.0 },
+            ),
+            (
+                Vec3::new(0.0, 0.0, 4.0),
+                crate::camera::Viewport::Orthographic { height: 6.0 },
+            ),
+        ];
+        #[cfg(target_arch = "x86_64")]
+        assert!(
+            crate::simd::cpu_has_avx2(),
+            "this test checks the AVX2 lanes"
+        );
+        let (mut covered, mut views) = (0, 0);
+        let precise_before = crate::edge::precise_tests();
+        for (eye, viewport) in viewports {
+            let camera = Camera {
+                name: "t".into(),
+                eye,
+                target: Vec3::new(0.0, 0.0, -1.0),
+                up: Vec3::Y,
+                viewport,
+                near: Some(0.05),
+            };
+            let view = View::new(&camera, 64, 48, 0.01).unwrap();
+            let mut corners = Vec::new();
+            let mut set_up = Vec::new();
+            while set_up.len() < 800 {
+                // Vertices on a coarse grid, so that edges pass through
+                // sample points.
+                let mut p = || {
+                    Vec3::new(
+                        rng.i32(-8..=8) as f32,
+                        rng.i32(-6..=6) as f32,
+                        rng.i32(-10..=4) as f32,
+                    ) * 0.5
+                };
+                let p = [p(), p(), p()];
+                if let Some(t) = Triangle3D::setup(&p, &view) {
+                    corners.push(p);
+                    set_up.push(t);
+                }
+            }
+            let shared = Shared3D::of_corners(&view, false, &corners);
+            for group in 0..4000 {
+                let tris: [Bound3D; 8] = std::array::from_fn(|_| {
+                    let k = rng.usize(..set_up.len());
+                    set_up[k].bind(&shared, k as u32, k as u32)
+                });
+                let x = std::array::from_fn(|_| rng.u32(0..256) as f32 * 0.25);
+                let y = std::array::from_fn(|_| rng.u32(0..192) as f32 * 0.25);
+                let active = if group % 2 == 0 { 0xff } else { rng.u8(..) };
+                let portable = Bound3D::sample_across::<crate::simd::Portable>(&tris, x, y, active);
+                #[cfg(target_arch = "x86_64")]
+                // SAFETY: the CPU has AVX2 (asserted above).
+                assert_eq!(unsafe { across_avx2(&tris, x, y, active) }.0, portable.0);
+                for l in 0..8 {
+                    let alone = tris[l].sample(x[l], y[l]).filter(|_| active >> l & 1 == 1);
+                    let lane = (portable.0 >> l & 1 == 1).then_some(portable.1[l]);
+                    assert_eq!(
+                        lane.map(f32::to_bits),
+                        alone.map(f32::to_bits),
+                        "group {group}, lane {l}"
+                    );
+                    #[cfg(target_arch = "x86_64")]
+                    {
+                        // SAFETY: as above.
+                        let (mask, w) = unsafe { across_avx2(&tris, x, y, active) };
+                        let lane = (mask >> l & 1 == 1).then_some(w[l]);
+                        assert_eq!(
+                            lane.map(f32::to_bits),
+                            alone.map(f32::to_bits),
+                            "AVX2: group {group}, lane {l}"
+                        );
+                    }
+                    covered += usize::from(alone.is_some());
+                }
+            }
+            views += 1;
+        }
+        assert_eq!(views, 2);
+        assert!(covered > 2_000, "only {covered} covered samples compared");
+        let precise = crate::edge::precise_tests()[0] - precise_before[0];
+        assert!(precise > 100, "only {precise} edge tests went past f32");
     }
 }

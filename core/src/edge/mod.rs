@@ -91,7 +91,7 @@ pub(crate) trait Stored: Send + Sync {
     /// What every triangle of one view shares.
     type Shared<'s>: Sync;
     /// The triangle as the coverage loops read it.
-    type Bound<'b>: Coverage
+    type Bound<'b>: Coverage + Copy
     where
         Self: 'b;
     /// Triangle `id`, item `item` of the setup that made it for the view
@@ -196,6 +196,28 @@ pub trait Coverage {
     #[inline(always)]
     fn sample_points8<L: Lanes>(&self, x: [f32; 8], y: [f32; 8], active: u8) -> (u8, [f32; 8]) {
         lanes8(active, |k| self.sample(x[k], y[k]))
+    }
+
+    /// Whether [`Coverage::sample_across`] tests eight triangles in one
+    /// group of lanes; otherwise it is each lane's [`Coverage::sample`] in
+    /// turn, and callers keep to one triangle per group.
+    const ACROSS: bool = false;
+
+    /// Coverage and depth of eight samples, each against its own triangle:
+    /// lane `l`'s point `(x[l], y[l])` against `tris[l]` (all set up for
+    /// one view), of which the lanes in `active` count. The same decisions
+    /// as each lane's [`Coverage::sample`].
+    #[inline(always)]
+    fn sample_across<L: Lanes>(
+        tris: &[Self; 8],
+        x: [f32; 8],
+        y: [f32; 8],
+        active: u8,
+    ) -> (u8, [f32; 8])
+    where
+        Self: Sized,
+    {
+        lanes8(active, |k| tris[k].sample(x[k], y[k]))
     }
 
     /// Does the triangle cover each of eight points (CSAA's coverage-only
