@@ -344,7 +344,7 @@ simd::dispatch! {
 
 #[inline(always)]
 fn test_across_on<L: Lanes, B: Coverage>(tile: &mut TileBuffer, q: &SmallQueue<B>) {
-    let (mask, w) = B::sample_across::<L>(&q.tris, q.x, q.y, first_lanes(q.n));
+    let (mask, w) = B::sample_across::<L>(q.tris.each_ref(), q.x, q.y, first_lanes(q.n));
     let mut covered = mask;
     while covered != 0 {
         let l = covered.trailing_zeros() as usize;

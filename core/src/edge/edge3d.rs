@@ -1039,7 +1039,7 @@ impl Coverage for Bound3D<'_> {
     /// depths.
     #[inline(always)]
     fn sample_across<L: Lanes>(
-        tris: &[Self; 8],
+        tris: [&Self; 8],
         x: [f32; 8],
         y: [f32; 8],
         active: u8,
@@ -1072,7 +1072,7 @@ impl Coverage for Bound3D<'_> {
         while undecided != 0 {
             let l = undecided.trailing_zeros() as usize;
             undecided &= undecided - 1;
-            let tri = &tris[l];
+            let tri = tris[l];
             if tri.inside(tri.t.edge_values(x[l], y[l]), x[l], y[l]) {
                 inside |= 1 << l;
             }
@@ -1148,9 +1148,9 @@ impl HomogeneousVertex {
 mod tests {
     use super::*;
     use crate::camera::Camera;
-    use crate::edge::lanes_test::lanes_agree;
     #[cfg(target_arch = "x86_64")]
     use crate::edge::lanes_test::lanes_agree_avx2;
+    use crate::edge::lanes_test::{across_agree, lanes_agree};
 
     /// A tolerance is kept as the least 10-bit float at or above it: never
     /// below it (a narrower bound would trust uncertain f32 signs), at most
@@ -1251,12 +1251,6 @@ mod tests {
         );
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn across_avx2(tris: &[Bound3D; 8], x: [f32; 8], y: [f32; 8], active: u8) -> (u8, [f32; 8]) {
-        Bound3D::sample_across::<crate::simd::Avx2>(tris, x, y, active)
-    }
-
     /// Eight samples each against its own triangle
     /// ([`Coverage::sample_across`]) give each triangle's own decision and
     /// depth ([`Coverage::sample`]) in the lanes asked for, on the portable
@@ -1278,11 +1272,6 @@ mod tests {
                 crate::camera::Viewport::Orthographic { height: 6.0 },
             ),
         ];
-        #[cfg(target_arch = "x86_64")]
-        assert!(
-            crate::simd::cpu_has_avx2(),
-            "this test checks the AVX2 lanes"
-        );
         let (mut covered, mut views) = (0, 0);
         let precise_before = crate::edge::precise_tests();
         for (eye, viewport) in viewports {
@@ -1314,40 +1303,10 @@ mod tests {
                 }
             }
             let shared = Shared3D::of_corners(&view, false, &corners);
-            for group in 0..4000 {
-                let tris: [Bound3D; 8] = std::array::from_fn(|_| {
-                    let k = rng.usize(..set_up.len());
-                    set_up[k].bind(&shared, k as u32, k as u32)
-                });
-                let x = std::array::from_fn(|_| rng.u32(0..256) as f32 * 0.25);
-                let y = std::array::from_fn(|_| rng.u32(0..192) as f32 * 0.25);
-                let active = if group % 2 == 0 { 0xff } else { rng.u8(..) };
-                let portable = Bound3D::sample_across::<crate::simd::Portable>(&tris, x, y, active);
-                #[cfg(target_arch = "x86_64")]
-                // SAFETY: the CPU has AVX2 (asserted above).
-                assert_eq!(unsafe { across_avx2(&tris, x, y, active) }.0, portable.0);
-                for l in 0..8 {
-                    let alone = tris[l].sample(x[l], y[l]).filter(|_| active >> l & 1 == 1);
-                    let lane = (portable.0 >> l & 1 == 1).then_some(portable.1[l]);
-                    assert_eq!(
-                        lane.map(f32::to_bits),
-                        alone.map(f32::to_bits),
-                        "group {group}, lane {l}"
-                    );
-                    #[cfg(target_arch = "x86_64")]
-                    {
-                        // SAFETY: as above.
-                        let (mask, w) = unsafe { across_avx2(&tris, x, y, active) };
-                        let lane = (mask >> l & 1 == 1).then_some(w[l]);
-                        assert_eq!(
-                            lane.map(f32::to_bits),
-                            alone.map(f32::to_bits),
-                            "AVX2: group {group}, lane {l}"
-                        );
-                    }
-                    covered += usize::from(alone.is_some());
-                }
-            }
+            let bound: Vec<Bound3D> = (set_up.iter().enumerate())
+                .map(|(k, t)| t.bind(&shared, k as u32, k as u32))
+                .collect();
+            covered += across_agree(&bound, 4000, &mut rng);
             views += 1;
         }
         assert_eq!(views, 2);

@@ -209,14 +209,11 @@ pub trait Coverage {
     /// as each lane's [`Coverage::sample`].
     #[inline(always)]
     fn sample_across<L: Lanes>(
-        tris: &[Self; 8],
+        tris: [&Self; 8],
         x: [f32; 8],
         y: [f32; 8],
         active: u8,
-    ) -> (u8, [f32; 8])
-    where
-        Self: Sized,
-    {
+    ) -> (u8, [f32; 8]) {
         lanes8(active, |k| tris[k].sample(x[k], y[k]))
     }
 
@@ -308,6 +305,16 @@ impl<L: Lanes, C: Coverage + ?Sized> RowLanes<L> for ByGroups<'_, C> {
 /// set-up triangles that are their own coverage).
 impl<C: Coverage> Coverage for &C {
     const OWN_SAMPLE_RUN: bool = C::OWN_SAMPLE_RUN;
+    const ACROSS: bool = C::ACROSS;
+    #[inline(always)]
+    fn sample_across<L: Lanes>(
+        tris: [&Self; 8],
+        x: [f32; 8],
+        y: [f32; 8],
+        active: u8,
+    ) -> (u8, [f32; 8]) {
+        C::sample_across::<L>(tris.map(|t| *t), x, y, active)
+    }
     #[inline(always)]
     fn sample(&self, x: f32, y: f32) -> Option<f32> {
         (**self).sample(x, y)
@@ -469,6 +476,63 @@ pub(crate) mod lanes_test {
     #[target_feature(enable = "avx2")]
     pub(crate) fn lanes_agree_avx2<T: Coverage>(t: &T, active: u8) -> (usize, Vec<u8>) {
         lanes_agree::<crate::simd::Avx2, T>(t, active)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn across_avx2<T: Coverage>(
+        tris: [&T; 8],
+        x: [f32; 8],
+        y: [f32; 8],
+        active: u8,
+    ) -> (u8, [f32; 8]) {
+        T::sample_across::<crate::simd::Avx2>(tris, x, y, active)
+    }
+
+    /// `groups` groups of eight samples on a quarter-pixel grid over the
+    /// 64×48 image, each lane against a triangle of `tris` drawn at random:
+    /// [`Coverage::sample_across`] on the portable lanes and on AVX2 gives
+    /// each lane's [`Coverage::sample`] in the lanes asked for (all of
+    /// them, or a random part). Returns the number of covered lanes compared.
+    pub(crate) fn across_agree<T: Coverage>(
+        tris: &[T],
+        groups: usize,
+        rng: &mut fastrand::Rng,
+    ) -> usize {
+        #[cfg(target_arch = "x86_64")]
+        assert!(
+            crate::simd::cpu_has_avx2(),
+            "this test checks the AVX2 lanes"
+        );
+        let mut covered = 0;
+        for group in 0..groups {
+            let eight: [&T; 8] = std::array::from_fn(|_| &tris[rng.usize(..tris.len())]);
+            let x = std::array::from_fn(|_| rng.u32(0..256) as f32 * 0.25);
+            let y = std::array::from_fn(|_| rng.u32(0..192) as f32 * 0.25);
+            let active = if group % 2 == 0 { 0xff } else { rng.u8(..) };
+            let portable = T::sample_across::<crate::simd::Portable>(eight, x, y, active);
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: the CPU has AVX2 (asserted above).
+            let avx2 = unsafe { across_avx2(eight, x, y, active) };
+            for l in 0..8 {
+                let alone = eight[l].sample(x[l], y[l]).filter(|_| active >> l & 1 == 1);
+                let lane = |(mask, w): (u8, [f32; 8])| (mask >> l & 1 == 1).then_some(w[l]);
+                let at = format!("group {group}, lane {l}");
+                assert_eq!(
+                    lane(portable).map(f32::to_bits),
+                    alone.map(f32::to_bits),
+                    "{at}"
+                );
+                #[cfg(target_arch = "x86_64")]
+                assert_eq!(
+                    lane(avx2).map(f32::to_bits),
+                    alone.map(f32::to_bits),
+                    "AVX2: {at}"
+                );
+                covered += usize::from(alone.is_some());
+            }
+        }
+        covered
     }
 
     /// Compares `t`'s `sample8` (and its row form, [`Coverage::rows`], with
