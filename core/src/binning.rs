@@ -252,9 +252,10 @@ fn sample_small<L: Lanes, T: Coverage>(
 /// small-triangle path of a tile that renders many triangles of a few
 /// samples each (a mesh of sub-pixel triangles averages under three), where
 /// [`sample_small`] would fill a group of lanes with one triangle's few
-/// samples. Each triangle's box is one [`sample_small`] would take
-/// ([`SmallQueue::takes`]); its samples are queued in the order that path
-/// forms them, at the same points, their tests counted as it counts them.
+/// samples. Each triangle's box is small ([`SmallQueue::takes`]: at most
+/// eight samples, every position stored); its samples are queued in the
+/// order [`sample_small`] forms them, at the same points, their tests
+/// counted as it counts them.
 /// Writes then come later than in input order, which changes no buffer: the
 /// depth test keeps the nearest sample and, at equal depth, the smaller id,
 /// whatever the order — so the queue is only for opaque triangles
