@@ -513,10 +513,13 @@ mod tests {
     /// and textured scenes; perspective, orthographic and parabolic views
     /// (pixels without a ray); a rasterizer and the ray caster; and a
     /// sphere with every third vertex normal zero (the face normal shades
-    /// its triangles).
+    /// its triangles); eights of one triangle (the box's faces, fig8's
+    /// floor under a second material) and of several.
     #[test]
     fn the_single_sample_resolve_matches_the_general_one() {
         let names = [
+            ("box", false),
+            ("fig8", false),
             ("soup", false),
             ("sphere", false),
             ("sphere", true),

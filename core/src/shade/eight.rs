@@ -163,36 +163,50 @@ impl Shader<'_> {
         debug_assert!(s.lanes != 0, "at least one lane to shade");
         let mut done = s.lanes;
         // 1. What each lane's triangle brings (lanes without one take the
-        // first that has one, so that every lane computes on real values),
-        // read in lanes: each lane's vertex record, then its three corners
-        // and normals, a row load each ([`Ops::gather_xyz`]) — no branch on
-        // how many triangles the eight holds, so the reads of every lane are
-        // on their way at once.
+        // first that has one, so that every lane computes on real values).
+        // Eight lanes of one triangle (most eights of a scene of large
+        // triangles) read it once and broadcast it; other eights read in
+        // lanes: each lane's vertex record, then its three corners and
+        // normals, a row load each ([`Ops::gather_xyz`]) — no branch on how
+        // many triangles they hold, so the reads of every lane are on their
+        // way at once. Either way every lane holds the same values, so the
+        // same colour.
         let first = s.ids[done.trailing_zeros() as usize];
         let ids: [u32; 8] = std::array::from_fn(|l| match done & (1 << l) {
             0 => first,
             _ => s.ids[l],
         });
-        let vertices = simd::gather_xyz_u32::<L>(mesh.triangles.as_flattened(), 3, ids);
-        let (positions, normals_flat) = (
-            bytemuck::cast_slice(&mesh.positions),
-            bytemuck::cast_slice(&mesh.normals),
-        );
+        let uniform = ids.iter().all(|&id| id == first);
         // (No closure around a lane operation: it would be compiled without
         // the lanes' instruction set.)
-        let [a, b, c] = vertices;
-        let [p0, p1, p2] = [
-            V3::gathered(positions, 3, a),
-            V3::gathered(positions, 3, b),
-            V3::gathered(positions, 3, c),
-        ];
         let mut normals = [V3::<L>::splat(Vec3::ZERO); 3];
+        let corners = if uniform {
+            let [a, b, c] = mesh.triangles[first as usize].map(|v| v as usize);
+            if interpolated {
+                let n = &mesh.normals;
+                normals = [V3::splat(n[a]), V3::splat(n[b]), V3::splat(n[c])];
+            }
+            let p = &mesh.positions;
+            [V3::splat(p[a]), V3::splat(p[b]), V3::splat(p[c])]
+        } else {
+            let [a, b, c] = simd::gather_xyz_u32::<L>(mesh.triangles.as_flattened(), 3, ids);
+            if interpolated {
+                let flat = bytemuck::cast_slice(&mesh.normals);
+                normals = [
+                    V3::gathered(flat, 3, a),
+                    V3::gathered(flat, 3, b),
+                    V3::gathered(flat, 3, c),
+                ];
+            }
+            let flat = bytemuck::cast_slice(&mesh.positions);
+            [
+                V3::gathered(flat, 3, a),
+                V3::gathered(flat, 3, b),
+                V3::gathered(flat, 3, c),
+            ]
+        };
+        let [p0, p1, p2] = corners;
         if interpolated {
-            normals = [
-                V3::gathered(normals_flat, 3, a),
-                V3::gathered(normals_flat, 3, b),
-                V3::gathered(normals_flat, 3, c),
-            ];
             // The scalar path's case (a zero vertex normal): these lanes go there.
             let zero = L::splat(0.0);
             for n in normals {
@@ -205,6 +219,13 @@ impl Shader<'_> {
                 (
                     V3::splat(Vec4::from(material.base_color).truncate()),
                     V3::splat(Vec3::from(material.emissive)),
+                )
+            }
+            rows if uniform => {
+                let row = rows[mesh.material_ids[first as usize] as usize];
+                (
+                    V3::splat(Vec3::new(row[0], row[1], row[2])),
+                    V3::splat(Vec3::new(row[4], row[5], row[6])),
                 )
             }
             rows => {
