@@ -67,7 +67,10 @@ impl CoverageHistogram {
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Stats {
     pub time_ms: StageTimes,
-    /// Triangles whose edge functions were set up (2D: clipped sub-triangles).
+    /// Triangles whose edge functions were set up (2D: clipped sub-triangles;
+    /// BVH traversals: the triangles of a node's leaves whose boxes meet the
+    /// frustum that rasterizes the first of them, set up together, some of
+    /// which a later occlusion test may spare from rasterization).
     pub triangle_setups: u64,
     /// Sample-against-triangle evaluations of the three edge functions: per-sample
     /// coverage tests, the four corner samples of every binning tile test, and the
@@ -158,9 +161,9 @@ pub struct RasterCounters {
     pub nodes_culled_outside: u64,
     /// BVH nodes culled because the hierarchical w-buffer hides them.
     pub nodes_culled_occluded: u64,
-    /// Leaf triangles a frustum reached that an earlier frustum of the same
-    /// work item had set up and the worker's leaf cache still held (their
-    /// setup reused, not counted again in `triangle_setups`).
+    /// Leaf triangles a frustum rasterized that an earlier frustum of the
+    /// same work item had rasterized and the worker's leaf cache still held
+    /// (their setup reused, not counted again in `triangle_setups`).
     pub leaf_setups_reused: u64,
     /// Runs of pixels (one per pixel row a triangle reaches) that the span
     /// traversal (`2dr-scanline`) found covered.

@@ -23,22 +23,26 @@ use crate::framebuffer::TileBuffer;
 use crate::ground::PixelRect;
 use crate::pipeline::TraversalOracles;
 use crate::prepared::PreparedScene;
-use crate::screen_boxes::ScreenBoxes;
+use crate::screen_boxes::{ScreenBoxes, rects_eight};
 use crate::simd::{self, Lanes, Portable};
 use crate::stats::RasterCounters;
 use crate::trace::{FrustumEvent, NodeOutcome};
 
-/// Sets up a leaf triangle's edge functions for a view (f32 or f64); the
-/// result may borrow both.
-pub(crate) type Setup<'a, T> = fn(&'a [Vec3; 3], &'a View) -> Option<T>;
+/// Sets up leaf triangles' edge functions for a view (f32 or f64): lane
+/// `l`'s, for the lanes of the `u8`, is the triangle with the corners at BVH
+/// slot `slots[l]` of the slice (`None` where it is seen edge-on, and in the
+/// other lanes); the results may borrow the corners and the view.
+pub(crate) type Setup<'a, T> = fn(&'a [[Vec3; 3]], [u32; 8], u8, &'a View) -> [Option<T>; 8];
 
 /// A leaf triangle as the frusta of one work item met it: its screen box
-/// (`None`: no sample on screen), and its setup once a frustum needed it
-/// (`Some(None)`: set up, but seen edge-on).
+/// (`None`: no sample on screen), its setup once a frustum needed it
+/// (`Some(None)`: set up, but seen edge-on), and whether a frustum has
+/// rasterized it since.
 #[derive(Clone, Copy, Debug)]
 struct Leaf<T> {
     rect: Option<PixelRect>,
     tri: Option<Option<T>>,
+    used: bool,
 }
 
 /// A [`LeafCache`] entry that holds no triangle.
@@ -73,6 +77,7 @@ impl<T: Copy> Default for LeafCache<T> {
                 Leaf {
                     rect: None,
                     tri: None,
+                    used: false,
                 };
                 LEAF_CACHE
             ],
@@ -98,11 +103,12 @@ pub(crate) struct Traversal<'a, 't, T: Stored> {
     pub setups: u64,
 }
 
-/// A node of the CWBVH: an inner node (index) or a leaf (primitive range).
+/// A node of the CWBVH: an inner node (index) or a leaf (primitive range,
+/// and the inner node whose child it is).
 #[derive(Clone, Copy, Debug)]
 enum NodeRef {
     Inner(u32),
-    Leaf { start: u32, count: u32 },
+    Leaf { start: u32, count: u32, parent: u32 },
 }
 
 /// A box with its nearest view-axis distance, and where its screen rect
@@ -365,7 +371,11 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
         }
         match node {
             // 3. generate_samples at leaves (Fig. 6d).
-            NodeRef::Leaf { start, count } => self.rasterize_leaf(f, start, count),
+            NodeRef::Leaf {
+                start,
+                count,
+                parent,
+            } => self.rasterize_leaf(f, start, count, parent),
             // 4. Children, nearest first.
             NodeRef::Inner(index) => self.visit_children(frustum, index),
         }
@@ -432,7 +442,11 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
             let c = usize::from(c);
             let r = if n.is_leaf(c) {
                 let (start, count) = n.child_primitives(c);
-                NodeRef::Leaf { start, count }
+                NodeRef::Leaf {
+                    start,
+                    count,
+                    parent: index,
+                }
             } else {
                 NodeRef::Inner(n.child_node_index(c))
             };
@@ -527,23 +541,93 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
         extent < w.max(h) as f32 * 0.5
     }
 
-    /// Sets up the leaf's triangles (those the leaf cache does not hold) and
-    /// rasterizes them over the frustum.
-    fn rasterize_leaf(&mut self, f: PixelRect, start: u32, count: u32) {
+    /// The boxes and setups of the triangles of `node`'s leaf children that
+    /// the leaf cache does not hold, made eight at a time ([`rects_eight`],
+    /// `setup`) when the first of them is rasterized: a leaf holds at most
+    /// three triangles, a node's leaves up to 24, so a batch fills its lanes
+    /// where a leaf's would not. Setups only for the triangles whose box
+    /// meets the frustum (`f`); a sibling leaf that a later frustum reaches
+    /// sets up what it lacks then.
+    fn prepare_leaves(&mut self, f: PixelRect, node: &CwBvhNode) {
+        let (mut slots, mut len) = ([0u32; 24], 0);
+        for c in 0..8 {
+            if !node.is_child_empty(c) && node.is_leaf(c) {
+                let (start, count) = node.child_primitives(c);
+                for slot in start..start + count {
+                    slots[len] = slot;
+                    len += 1;
+                }
+            }
+        }
+        for eight in slots[..len].chunks(8) {
+            self.prepare_eight(f, eight);
+        }
+    }
+
+    /// [`Traversal::prepare_leaves`] of one to eight slots.
+    fn prepare_eight(&mut self, f: PixelRect, eight: &[u32]) {
         let scene = self.scene;
+        let (view, span) = (self.view, self.tile.pattern.span);
+        // Lanes past the eight's end repeat its last slot.
+        let slots: [u32; 8] = std::array::from_fn(|l| eight[l.min(eight.len() - 1)]);
+        let entry = |l: usize| slots[l] as usize % LEAF_CACHE;
+        let mut missing = 0u8;
+        for (l, &slot) in eight.iter().enumerate() {
+            if self.leaves.slots[entry(l)] != slot {
+                missing |= 1 << l;
+            }
+        }
+        if missing != 0 {
+            let vertices = slots.map(|slot| scene.slot_vertices[slot as usize]);
+            let (boxes, positions) = (self.boxes, &scene.slot_positions);
+            let rects = rects_eight(boxes, &vertices, eight.len(), positions, view, span);
+            for l in (0..8).filter(|l| missing >> l & 1 == 1) {
+                self.leaves.slots[entry(l)] = slots[l];
+                self.leaves.leaves[entry(l)] = Leaf {
+                    rect: rects[l],
+                    tri: None,
+                    used: false,
+                };
+            }
+        }
+        let mut wanted = 0u8;
+        for l in 0..eight.len() {
+            let leaf = &self.leaves.leaves[entry(l)];
+            if leaf.tri.is_none() && leaf.rect.is_some_and(|r| r.intersect(f).is_some()) {
+                wanted |= 1 << l;
+            }
+        }
+        if wanted != 0 {
+            let made = (self.setup)(&scene.slot_corners, slots, wanted, view);
+            for l in (0..8).filter(|l| wanted >> l & 1 == 1) {
+                self.leaves.leaves[entry(l)].tri = Some(made[l]);
+            }
+            self.setups += u64::from(wanted.count_ones());
+        }
+    }
+
+    /// Rasterizes the leaf's triangles over the frustum, set up with the
+    /// leaves of its `parent` node ([`Traversal::prepare_leaves`]) when the
+    /// leaf cache does not hold its first, else one by one where the cache
+    /// lacks them.
+    fn rasterize_leaf(&mut self, f: PixelRect, start: u32, count: u32, parent: u32) {
+        let scene = self.scene;
+        if self.leaves.slots[start as usize % LEAF_CACHE] != start {
+            self.prepare_leaves(f, &scene.bvh.cwbvh.nodes[parent as usize]);
+        }
         self.tile
             .record(|t| t.frusta.push((f, FrustumEvent::Rasterized)));
         let (view, boxes, span) = (self.view, self.boxes, self.tile.pattern.span);
         let shared = self.shared;
         for slot in start..start + count {
-            // The slot-ordered copies: a leaf's triangles sit side by side.
-            let p = &scene.slot_corners[slot as usize];
             let entry = slot as usize % LEAF_CACHE;
             let leaf = &mut self.leaves.leaves[entry];
             if std::mem::replace(&mut self.leaves.slots[entry], slot) != slot {
+                let p = &scene.slot_corners[slot as usize];
                 *leaf = Leaf {
                     rect: boxes.rect(p, scene.slot_vertices[slot as usize], view, span),
                     tri: None,
+                    used: false,
                 };
             }
             let Some(clip) = leaf.rect.and_then(|rect| rect.intersect(f)) else {
@@ -552,14 +636,17 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
             // By reference: a setup is a cache line or more.
             let tri = match &mut leaf.tri {
                 Some(tri) => {
-                    self.counters.leaf_setups_reused += 1;
+                    if leaf.used {
+                        self.counters.leaf_setups_reused += 1;
+                    }
                     tri
                 }
                 none => {
                     self.setups += 1;
-                    none.insert((self.setup)(p, view))
+                    none.insert((self.setup)(&scene.slot_corners, [slot; 8], 1, view)[0])
                 }
             };
+            leaf.used = true;
             let Some(tri) = tri else {
                 continue;
             };

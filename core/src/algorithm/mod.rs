@@ -33,7 +33,7 @@ use rayon::prelude::*;
 use crate::aa::SamplePattern;
 use crate::binning::raster_triangle;
 use crate::camera::View;
-use crate::edge::{CurvedTriangle, Stored, Triangle3D, Triangle3D64};
+use crate::edge::{CurvedTriangle, Stored, Triangle3D64};
 use crate::framebuffer::{Framebuffer, TileBuffer, TilePlanes, TileTotals};
 use crate::ground::{FieldError, PixelRect};
 use crate::pipeline::{EdgeKind, Pipeline, TraversalOracles};
@@ -112,9 +112,15 @@ pub(crate) fn run(
                 EdgeKind::ThreeD => tiles!(setup3d::setup_3d(scene, view, span)),
             }
         }
-        Pipeline::Frusta(oracles) if f64 => {
-            render_frusta(scene, context, oracles, fb, stats, &(), Triangle3D64::setup)
-        }
+        Pipeline::Frusta(oracles) if f64 => render_frusta(
+            scene,
+            context,
+            oracles,
+            fb,
+            stats,
+            &(),
+            setup3d::leaf_setups_3d_f64,
+        ),
         Pipeline::Frusta(oracles) => {
             let shared = setup3d::slot_shared_3d(scene, view);
             render_frusta(
@@ -124,7 +130,7 @@ pub(crate) fn run(
                 fb,
                 stats,
                 &shared,
-                Triangle3D::setup,
+                setup3d::leaf_setups_3d,
             )
         }
         Pipeline::Rays { packet } if view.sphere.is_some() => {

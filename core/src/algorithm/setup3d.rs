@@ -206,6 +206,49 @@ fn set_up_packed<L: Lanes>(
     }
 }
 
+simd::dispatch! {
+    /// [`Triangle3D::setup`] of the triangles with corners `corners[slots[l]]`
+    /// for the lanes of `wanted`: the same setups, made eight at a time
+    /// ([`Triangle3D::setup_lanes`]) — the leaf triangles a BVH node's
+    /// frustum reaches (paper §3.2, Fig. 7).
+    pub(crate) fn leaf_setups_3d<>(
+        corners: &[[Vec3; 3]],
+        slots: [u32; 8],
+        wanted: u8,
+        view: &View,
+    ) -> [Option<Triangle3D>; 8] => leaf_setups_3d_on
+}
+
+#[inline(always)]
+fn leaf_setups_3d_on<L: Lanes>(
+    corners: &[[Vec3; 3]],
+    slots: [u32; 8],
+    wanted: u8,
+    view: &View,
+) -> [Option<Triangle3D>; 8] {
+    // Corner `k` of slot `s`: floats `9s + 3k ..`, a row of the floats from `3k` on.
+    let flat: &[f32] = bytemuck::cast_slice(corners);
+    let lanes = [
+        L::gather_xyz(flat, 9, slots),
+        L::gather_xyz(&flat[3..], 9, slots),
+        L::gather_xyz(&flat[6..], 9, slots),
+    ];
+    Triangle3D::setup_lanes(&lanes, wanted, view, |l| corners[slots[l] as usize])
+}
+
+/// [`leaf_setups_3d`] in f64, one at a time ([`Triangle3D64::setup`]).
+pub(crate) fn leaf_setups_3d_f64(
+    corners: &[[Vec3; 3]],
+    slots: [u32; 8],
+    wanted: u8,
+    view: &View,
+) -> [Option<Triangle3D64>; 8] {
+    std::array::from_fn(|l| match wanted >> l & 1 {
+        1 => Triangle3D64::setup(&corners[slots[l] as usize], view),
+        _ => None,
+    })
+}
+
 /// What the view's [`Triangle3D`]s share, set up by the 3D setup or the
 /// homogeneous one.
 pub(crate) fn shared_3d<'a>(
@@ -506,6 +549,60 @@ mod tests {
             checked > 10_000 && set_up > 1_000 && scalar_boxes > 500 && packed > 100,
             "{checked} items checked, {set_up} set up, {scalar_boxes} boxed by the scalar \
              path, {packed} blocks packed"
+        );
+    }
+
+    /// The leaf setups of eight slots ([`leaf_setups_3d`]) are
+    /// [`Triangle3D::setup`]'s of each slot of the lanes asked for, bit for
+    /// bit, and `None` in the others: slots in any order, repeated, the
+    /// last slot (whose corners end the slice), on both lane sets.
+    #[test]
+    fn leaf_setups_are_the_one_by_one_ones() {
+        type Setups = fn(&[[Vec3; 3]], [u32; 8], u8, &View) -> [Option<Triangle3D>; 8];
+        let kernels: [Setups; 2] = [leaf_setups_3d_on::<simd::Portable>, leaf_setups_3d];
+        let mut rng = fastrand::Rng::with_seed(7);
+        let (mut checked, mut set_up, mut last) = (0, 0, 0);
+        for case in 0..200 {
+            let eye = Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 4.0;
+            let camera = Camera {
+                name: "test".into(),
+                eye,
+                target: eye - Vec3::Z + Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, 0.0),
+                up: Vec3::Y,
+                viewport: Viewport::Perspective { fov_y_deg: 60.0 },
+                near: Some(0.1),
+            };
+            let view = View::new(&camera, 320, 200, 0.1).expect("a valid camera");
+            let positions: Vec<Vec3> = (0..30)
+                .map(|_| eye + Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, -rng.f32()) * 3.0)
+                .collect();
+            let records: Vec<[u32; 3]> = (0..20)
+                .map(|_| [rng.u32(0..30), rng.u32(0..30), rng.u32(0..30)])
+                .collect();
+            let corners: Vec<[Vec3; 3]> = (records.iter())
+                .map(|r| r.map(|v| positions[v as usize]))
+                .collect();
+            let slots: [u32; 8] = std::array::from_fn(|_| rng.u32(0..20));
+            let wanted = rng.u8(..);
+            let kernel = kernels[case % 2];
+            let made = kernel(&corners, slots, wanted, &view);
+            for l in 0..8 {
+                let slot = slots[l] as usize;
+                let tri = match wanted >> l & 1 {
+                    1 => Triangle3D::setup(&corners[slot], &view),
+                    _ => None,
+                };
+                // Debug shows the sign of a zero, which `==` does not.
+                let at = format!("case {case}, lane {l}, slot {slot}");
+                assert_eq!(format!("{:?}", made[l]), format!("{tri:?}"), "{at}");
+                checked += 1;
+                set_up += usize::from(tri.is_some());
+                last += usize::from(wanted >> l & 1 == 1 && slot == 19);
+            }
+        }
+        assert!(
+            checked == 1600 && set_up > 400 && last > 20,
+            "{checked} lanes checked, {set_up} set up, {last} of the last slot"
         );
     }
 

@@ -162,10 +162,13 @@ fn the_final_depth_oracle_bounds_occlusion_culling() {
             b.bvh_nodes_visited,
             a.bvh_nodes_visited
         );
-        // Measured: 0.70 of the setups; reading the depths per sample as they
-        // come (no first traversal) set up 0.76.
+        // Measured: 0.80 of the setups (3dr-frustum-split) since a leaf's first
+        // rasterization sets up the triangles of its node's other leaves
+        // with it, some of which occlusion culling then spares (0.70 when
+        // each leaf set up its own; reading the depths per sample as they
+        // come, with no first traversal, set up 0.76 of those).
         assert!(
-            b.triangle_setups * 100 < a.triangle_setups * 73,
+            b.triangle_setups * 100 < a.triangle_setups * 85,
             "{algorithm}: triangle setups {} with the final depths, {} as it goes",
             b.triangle_setups,
             a.triangle_setups
