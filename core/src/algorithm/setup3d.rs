@@ -452,6 +452,20 @@ mod tests {
 
     type Kernel = fn(&LaneMesh, &[u32], Option<u32>) -> Block;
 
+    /// A camera at a random place looking about down −z with a vertical
+    /// field of `fov_y_deg`.
+    fn looking_down_z(rng: &mut fastrand::Rng, fov_y_deg: f32) -> Camera {
+        let eye = Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 4.0;
+        Camera {
+            name: "test".into(),
+            eye,
+            target: eye - Vec3::Z + Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, 0.0),
+            up: Vec3::Y,
+            viewport: Viewport::Perspective { fov_y_deg },
+            near: Some(0.1),
+        }
+    }
+
     /// `kernel` gives every item the box [`ScreenBoxes::rect`] gives and the
     /// set-up triangle the eight-at-a-time path gives
     /// ([`Triangle3D::setup_eight`], checked against the one-triangle form),
@@ -463,17 +477,8 @@ mod tests {
         let mut rng = fastrand::Rng::with_seed(31);
         let (mut checked, mut set_up, mut scalar_boxes, mut packed) = (0, 0, 0, 0);
         for case in 0..300 {
-            let eye = Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 4.0;
-            let camera = Camera {
-                name: "test".into(),
-                eye,
-                target: eye - Vec3::Z + Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, 0.0),
-                up: Vec3::Y,
-                viewport: Viewport::Perspective {
-                    fov_y_deg: [20.0, 60.0, 120.0][case % 3],
-                },
-                near: Some(0.1),
-            };
+            let camera = looking_down_z(&mut rng, [20.0, 60.0, 120.0][case % 3]);
+            let eye = camera.eye;
             let size = (rng.u32(1..400), rng.u32(1..400));
             let view = View::new(&camera, size.0, size.1, 0.1).expect("a valid camera");
             let scale = [3.0, 0.05, 40.0][case / 3 % 3];
@@ -563,15 +568,8 @@ mod tests {
         let mut rng = fastrand::Rng::with_seed(7);
         let (mut checked, mut set_up, mut last) = (0, 0, 0);
         for case in 0..200 {
-            let eye = Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 4.0;
-            let camera = Camera {
-                name: "test".into(),
-                eye,
-                target: eye - Vec3::Z + Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, 0.0),
-                up: Vec3::Y,
-                viewport: Viewport::Perspective { fov_y_deg: 60.0 },
-                near: Some(0.1),
-            };
+            let camera = looking_down_z(&mut rng, 60.0);
+            let eye = camera.eye;
             let view = View::new(&camera, 320, 200, 0.1).expect("a valid camera");
             let positions: Vec<Vec3> = (0..30)
                 .map(|_| eye + Vec3::new(rng.f32() - 0.5, rng.f32() - 0.5, -rng.f32()) * 3.0)
