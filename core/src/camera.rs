@@ -106,6 +106,11 @@ impl Camera {
     }
 }
 
+/// [`View::sample_extent`] of an image `width × height`.
+fn sample_extent(width: u32, height: u32) -> (f32, f32) {
+    (width as f32 + 1.0, height as f32 + 1.0)
+}
+
 /// A camera at one image size: the sample generator of paper §3.2.
 #[derive(Clone, Debug, PartialEq)]
 pub struct View {
@@ -144,6 +149,32 @@ pub struct View {
     pub half_x: f32,
     /// The sample generator of a non-planar viewport.
     pub sphere: Option<SphereMap>,
+    /// Bounds on the planar sample directions over the image, for the
+    /// error bounds of edge functions evaluated on it.
+    pub(crate) directions: DirectionBounds,
+}
+
+/// What the error bounds of perspective edge functions need of the sample
+/// direction `d(x, y) = d0 + x·dx + y·dy` over the image's samples,
+/// `(x, y) ∈ [−1, x_max] × [−1, y_max]` ([`View::sample_extent`]), per
+/// component: the largest `|d|` (at a corner, `|d|` being convex), and the
+/// largest `|d0| + |x|·|dx| + |y|·|dy|`, which bounds how the errors of
+/// three coefficients `n·d0`, `n·dx`, `n·dy` add up at a sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct DirectionBounds {
+    pub(crate) largest: Vec3,
+    pub(crate) reach: Vec3,
+}
+
+impl DirectionBounds {
+    fn of(d0: Vec3, dx: Vec3, dy: Vec3, (x_max, y_max): (f32, f32)) -> DirectionBounds {
+        let d = |x: f32, y: f32| (d0 + dx * x + dy * y).abs();
+        let largest = (d(-1.0, -1.0).max(d(x_max, -1.0))).max(d(-1.0, y_max).max(d(x_max, y_max)));
+        DirectionBounds {
+            largest,
+            reach: d0.abs() + dx.abs() * x_max + dy.abs() * y_max,
+        }
+    }
 }
 
 impl View {
@@ -213,7 +244,15 @@ impl View {
             half_y,
             half_x,
             sphere: SphereMap::new(camera.viewport, width, height),
+            directions: DirectionBounds::of(d0, dx, dy, sample_extent(width, height)),
         })
+    }
+
+    /// The image's largest sample coordinates: the pattern's offsets stay
+    /// within one pixel of the image.
+    #[inline]
+    pub(crate) fn sample_extent(&self) -> (f32, f32) {
+        sample_extent(self.width, self.height)
     }
 
     /// Is this an orthographic view?

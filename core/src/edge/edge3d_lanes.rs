@@ -13,7 +13,9 @@
 use glam::Vec3;
 
 use super::EightTriangles;
-use super::edge3d::{EPS, HomogeneousVertex, SCALE_ABOVE, Tolerances, Triangle3D, image_extent};
+use super::edge3d::{
+    BOUND_MARGIN, EPS, HomogeneousVertex, SCALE_ABOVE, Tolerances, Triangle3D, image_extent,
+};
 use super::homogeneous::setup_homogeneous_from;
 use crate::camera::View;
 use crate::simd::{self, Lanes};
@@ -271,12 +273,12 @@ fn abs<L: Lanes>(v: L) -> L {
 }
 
 /// `from_linear`'s tolerance of edge `e` with coefficient error `r`:
-/// `2·(r + 4ε·((|A| + x_max·|B|) + y_max·|C|))`.
+/// `BOUND_MARGIN·(r + 3ε·((|A| + x_max·|B|) + y_max·|C|))`.
 #[inline(always)]
 fn tolerance<L: Lanes>(e: [L; 3], r: L, (x_max, y_max): (f32, f32)) -> L {
-    let evaluation = L::splat(4.0 * EPS)
+    let evaluation = L::splat(3.0 * EPS)
         * (abs(e[0]) + L::splat(x_max) * abs(e[1]) + L::splat(y_max) * abs(e[2]));
-    L::splat(2.0) * (r + evaluation)
+    L::splat(BOUND_MARGIN) * (r + evaluation)
 }
 
 /// `nan` plus zero times each of `values`: NaN when one is not finite.
@@ -296,12 +298,18 @@ fn arrays<L: Lanes>(v: [L; 3]) -> [[f32; 8]; 3] {
 /// The perspective edge function of edge `(a, b)` oriented by `sign`, and its
 /// coefficient error bound (`perspective_edge` of [`super::edge3d`]).
 #[inline(always)]
-fn edge_lanes<L: Lanes>(a: V<L>, b: V<L>, sign: L, d_abs: Vec3, view: &View) -> ([L; 3], L) {
+fn edge_lanes<L: Lanes>(a: V<L>, b: V<L>, sign: L, view: &View) -> ([L; 3], L) {
+    let directions = &view.directions;
     let (sum, u) = (a.add(b), a.sub(b));
-    let error = L::splat(8.0 * EPS) * sum.scale(L::splat(0.5)).abs_cross(u).dot_with(d_abs);
     // `edge_normal`: (−(a + b)·½) × (a − b); negation is a product by −1.
-    let m = sum.scale(L::splat(-1.0)).scale(L::splat(0.5));
-    (m.cross(u).scale(sign).along(view), error)
+    let n = sum.scale(L::splat(-1.0)).scale(L::splat(0.5)).cross(u);
+    let error = L::splat(4.0 * EPS)
+        * sum
+            .scale(L::splat(0.5))
+            .abs_cross(u)
+            .dot_with(directions.largest)
+        + L::splat(3.0 * EPS) * n.abs().dot_with(directions.reach);
+    (n.scale(sign).along(view), error)
 }
 
 /// The lanes of [`Triangle3D::setup`], step for step: its perspective
@@ -344,11 +352,10 @@ fn perspective_of<L: Lanes>([c0, c1, c2]: [V<L>; 3], w: [L; 3], view: &View) -> 
     let o = Orientation::of(c0, c1, c2);
     // 3. The three edges (edge i opposite vertex i) and their errors.
     let extent = image_extent(view);
-    let d_abs = view.d0.abs() + view.dx.abs() * extent.0 + view.dy.abs() * extent.1;
     let edges = [
-        edge_lanes(c1, c2, o.sign, d_abs, view),
-        edge_lanes(c2, c0, o.sign, d_abs, view),
-        edge_lanes(c0, c1, o.sign, d_abs, view),
+        edge_lanes(c1, c2, o.sign, view),
+        edge_lanes(c2, c0, o.sign, view),
+        edge_lanes(c0, c1, o.sign, view),
     ];
     let nd = o.normal.scale(o.sign).along(view);
     finished(edges, nd, w, &o, extent)

@@ -99,6 +99,12 @@ impl Expansion {
             .fold(Expansion::default(), |acc, &b| acc.add(&self.scale(b)))
     }
 
+    /// The value rounded to about an f64 (the components' sum).
+    #[cfg(test)]
+    pub fn approximate(&self) -> f64 {
+        self.0.iter().sum()
+    }
+
     /// The sign of the exact value: −1, 0 or 1.
     pub fn signum(&self) -> i32 {
         match self.0.last() {

@@ -177,6 +177,15 @@ fn extent() -> vec2<f32> {
     return vec2<f32>(f32(P.size.x) + 1.0, f32(P.size.y) + 1.0);
 }
 
+// `|d(x, y)|` per component, the sample direction at image point (x, y).
+fn direction_size(x: f32, y: f32) -> vec3<f32> {
+    return abs(P.d0.xyz + P.dx.xyz * x + P.dy.xyz * y);
+}
+
+// `BOUND_MARGIN` of `edge3d.rs`: the first-order error bounds are taken
+// with it (their O(ε²) terms and their own rounding).
+const BOUND_MARGIN: f32 = 1.0009765625;
+
 // Is the f32 determinant `d` (error at most `bound`) of certain sign? If
 // not, the triangle `id` is listed for the CPU, whose setup takes the exact
 // sign (`edge3d::orientation`), and this returns false.
@@ -193,12 +202,12 @@ fn oriented(id: u32, d: f32, bound: f32) -> bool {
 // A 3D or homogeneous triangle from its linear edge functions (rows: A, B, C
 // per edge), `nd` and `volume`, and each edge's coefficient error over the
 // image (`Triangle3D::from_linear`, which adds the evaluation's rounding:
-// (A + x·B) + y·C rounds four times, by at most ε of the terms' magnitudes
-// each; both bounds doubled for margin).
+// (A + x·B) + y·C is within 3ε of the terms' magnitudes; both bounds taken
+// with BOUND_MARGIN).
 fn linear_tri(id: u32, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, nd: vec3<f32>, volume: vec3<f32>, w: vec3<f32>, coefficient_error: vec3<f32>, pbox: vec2<u32>) -> Tri {
     var t: Tri;
     let x = extent();
-    let tolerance = 2.0 * (coefficient_error + 4.0 * F32_EPS * (abs(a) + x.x * abs(b) + x.y * abs(c)));
+    let tolerance = BOUND_MARGIN * (coefficient_error + 3.0 * F32_EPS * (abs(a) + x.x * abs(b) + x.y * abs(c)));
     if !(finite3(a) && finite3(b) && finite3(c) && finite3(nd) && finite3(volume) && finite3(w) && finite3(tolerance)) || pbox.x == pbox.y {
         return empty_tri();
     }
@@ -383,17 +392,22 @@ fn setup_3d(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) group
             return;
         }
         let s = select(-1.0, 1.0, d > 0.0);
-        // Each edge's coefficients are within 8ε of |m| ⊗ |u| along the
-        // largest sample direction.
-        let d_abs = abs(P.d0.xyz) + abs(P.dx.xyz) * x.x + abs(P.dy.xyz) * x.y;
+        // Each edge's normal is within 4ε of |m| ⊗ |u|, which moves its value
+        // by at most that along the largest |d|; its three coefficients round
+        // by 3ε of |n| along `reach` (`perspective_edge` of edge3d.rs).
+        let largest = max(max(direction_size(-1.0, -1.0), direction_size(x.x, -1.0)),
+                          max(direction_size(-1.0, x.y), direction_size(x.x, x.y)));
+        let reach = abs(P.d0.xyz) + abs(P.dx.xyz) * x.x + abs(P.dy.xyz) * x.y;
         for (var i = 0u; i < 3u; i++) {
             let p = c[(i + 1u) % 3u];
             let q = c[(i + 2u) % 3u];
-            let e = along(cross3(-(p + q) * 0.5, p - q) * s);
+            let n = cross3(-(p + q) * 0.5, p - q);
+            let e = along(n * s);
             a[i] = e.x;
             b[i] = e.y;
             cc[i] = e.z;
-            error[i] = 8.0 * F32_EPS * dot3(abs_cross((p + q) * 0.5, p - q), d_abs);
+            error[i] = 4.0 * F32_EPS * dot3(abs_cross((p + q) * 0.5, p - q), largest)
+                + 3.0 * F32_EPS * dot3(abs(n), reach);
         }
         set_up(k, linear_tri(l.id, a, b, cc, along(normal * s), vec3<f32>(abs(d) * scale, 0.0, 0.0), w, error, pbox));
     } else {
