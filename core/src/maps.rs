@@ -34,12 +34,17 @@ pub fn edge_eval_image(fb: &Framebuffer) -> RgbaImage {
         return from_pixels(fb, std::iter::repeat_n([0, 0, 0, 255], fb.color.len()));
     }
     let max = fb.edge_evals.iter().copied().max().unwrap_or(0);
-    from_pixels(
-        fb,
-        fb.edge_evals
-            .iter()
-            .map(|&n| heat_color(heat_position(n, max))),
-    )
+    // Counts run from 0 to `max` (tens on most frames), so each colour is
+    // computed once, not once per pixel (an inferno spline in f64 each);
+    // per pixel only where the counts outnumber the pixels.
+    if max as usize > fb.edge_evals.len() {
+        let colors = fb.edge_evals.iter();
+        return from_pixels(fb, colors.map(|&n| heat_color(heat_position(n, max))));
+    }
+    let colors: Vec<[u8; 4]> = (0..=max)
+        .map(|n| heat_color(heat_position(n, max)))
+        .collect();
+    from_pixels(fb, fb.edge_evals.iter().map(|&n| colors[n as usize]))
 }
 
 /// Depth as grey: nearest visible surface white, farthest dark grey, background black.
@@ -95,4 +100,33 @@ pub fn png_bytes(img: &RgbaImage) -> Vec<u8> {
         )
         .expect("encoding to memory cannot fail");
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The heat map gives each pixel the colour of its own count, whether
+    /// the colours are computed once per count (counts below the pixel
+    /// count) or per pixel (a larger count somewhere).
+    #[test]
+    fn heat_map_colours_each_pixel_by_its_count() {
+        let mut fb = Framebuffer::new(4, 3);
+        for counts in [
+            vec![0, 1, 2, 3, 5, 8, 0, 1, 2, 3, 5, 11],
+            vec![0, 1, 7, 1_000, 0, 2, 3, 4, 5, 6, 7, 8],
+        ] {
+            fb.edge_evals = counts;
+            let max = *fb.edge_evals.iter().max().unwrap();
+            let image = edge_eval_image(&fb);
+            for (k, &n) in fb.edge_evals.iter().enumerate() {
+                let pixel = image.get_pixel(k as u32 % 4, k as u32 / 4).0;
+                assert_eq!(
+                    pixel,
+                    heat_color(heat_position(n, max)),
+                    "pixel {k}, count {n}"
+                );
+            }
+        }
+    }
 }
