@@ -335,12 +335,6 @@ fn all_finite<const N: usize>(values: &[[f32; 3]; N]) -> bool {
 /// Linear functions of the image point, `k[0] + x·k[1] + y·k[2]`.
 pub type Linear = [f32; 3];
 
-/// The image's largest sample coordinates ([`View::sample_extent`]).
-#[inline]
-pub(crate) fn image_extent(view: &View) -> (f32, f32) {
-    view.sample_extent()
-}
-
 /// The factor every error bound is taken with: the bounds are first-order
 /// (multiples of ε of magnitudes), each leading constant at or above its
 /// derivation's, and this covers what they leave out — the `O(ε²)` terms
@@ -442,7 +436,7 @@ impl Triangle3D {
         let sign = if positive { 1.0 } else { -1.0 };
         // k·(q − o(x, y)) = k·(q − o0) − x·k·ox − y·k·oy, all relative to the eye.
         let toward = |k: Vec3, q: Vec3| [k.dot(q - o0), -k.dot(ox), -k.dot(oy)];
-        let (x_max, y_max) = image_extent(view);
+        let (x_max, y_max) = view.sample_extent();
         let o_abs = o0.abs() + ox.abs() * x_max + oy.abs() * y_max;
         let mut coefficient_error = [0.0; 3];
         let edges = [0, 1, 2].map(|i| {
@@ -472,7 +466,7 @@ impl Triangle3D {
         coefficient_error: [f32; 3],
         negated: bool,
     ) -> Option<Triangle3D> {
-        let (x_max, y_max) = image_extent(view);
+        let (x_max, y_max) = view.sample_extent();
         // (A + x·B) + y·C rounds four times; no term passes through more
         // than three of them, so the value is within 3ε of the terms'
         // magnitudes. Both bounds are first-order: taken with BOUND_MARGIN.
@@ -1373,7 +1367,7 @@ mod tests {
         let (mut checked, mut largest) = (0, 0.0f64);
         for (camera, homogeneous) in views {
             let view = View::new(&camera, 1920, 1080, 0.01).unwrap();
-            let (x_max, y_max) = image_extent(&view);
+            let (x_max, y_max) = view.sample_extent();
             let mut corners = Vec::new();
             let mut set_up = Vec::new();
             while set_up.len() < 600 {

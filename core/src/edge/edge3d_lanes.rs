@@ -13,9 +13,7 @@
 use glam::Vec3;
 
 use super::EightTriangles;
-use super::edge3d::{
-    BOUND_MARGIN, EPS, HomogeneousVertex, SCALE_ABOVE, Tolerances, Triangle3D, image_extent,
-};
+use super::edge3d::{BOUND_MARGIN, EPS, HomogeneousVertex, SCALE_ABOVE, Tolerances, Triangle3D};
 use super::homogeneous::setup_homogeneous_from;
 use crate::camera::View;
 use crate::simd::{self, Lanes};
@@ -351,7 +349,7 @@ fn perspective_of<L: Lanes>([c0, c1, c2]: [V<L>; 3], w: [L; 3], view: &View) -> 
     // 2. The volume D = N·c0 and its certain signs.
     let o = Orientation::of(c0, c1, c2);
     // 3. The three edges (edge i opposite vertex i) and their errors.
-    let extent = image_extent(view);
+    let extent = view.sample_extent();
     let edges = [
         edge_lanes(c1, c2, o.sign, view),
         edge_lanes(c2, c0, o.sign, view),
@@ -375,7 +373,7 @@ fn orthographic_of<L: Lanes>([c0, c1, c2]: [V<L>; 3], w: [L; 3], view: &View) ->
     let bound = L::splat(16.0 * EPS) * e1.abs_cross(e2).dot_with(dp.abs());
     let o = Orientation::decided(normal, facing, bound, unscaled(c0, c1, c2));
     // 3. The edges, `d_p × (a − b)` through the midpoint, and their errors.
-    let extent = image_extent(view);
+    let extent = view.sample_extent();
     let o_abs = view.o0.abs() + view.ox.abs() * extent.0 + view.oy.abs() * extent.1;
     let edges = [
         parallel_edge(c1, c2, o.sign, o_abs, view),
@@ -433,7 +431,7 @@ fn homogeneous_lanes_on<L: Lanes>(h: &Corners, w: &[[f32; 8]; 3], view: &View) -
     // 1. The determinant det[h0, h1, h2] = N·h0 and its certain signs.
     let o = Orientation::of(h0, h1, h2);
     // 2. The rows of the adjugate (edge i opposite vertex i) and their errors.
-    let extent = image_extent(view);
+    let extent = view.sample_extent();
     let edges = [
         row_lanes(h1, h2, o.sign, extent),
         row_lanes(h2, h0, o.sign, extent),

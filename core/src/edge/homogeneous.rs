@@ -12,7 +12,7 @@
 use glam::Vec3;
 
 use super::Triangle3D;
-use super::edge3d::{Depth, EPS, HomogeneousVertex, abs_cross, image_extent, orientation, scaled};
+use super::edge3d::{Depth, EPS, HomogeneousVertex, abs_cross, orientation, scaled};
 use super::exact;
 use crate::camera::View;
 
@@ -67,7 +67,7 @@ pub(crate) fn setup_homogeneous_from(
         }
     };
     // Each row's rounding is at most 5ε of |m| ⊗ |u|, evaluated at (x, y, 1).
-    let (x_max, y_max) = image_extent(view);
+    let (x_max, y_max) = view.sample_extent();
     let coefficient_error = [0, 1, 2].map(|i| {
         let (a, b) = (h[(i + 1) % 3], h[(i + 2) % 3]);
         let t = abs_cross((a + b) * 0.5, b - a);

@@ -172,7 +172,7 @@ fn abs_cross(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(p.y * q.z + p.z * q.y, p.z * q.x + p.x * q.z, p.x * q.y + p.y * q.x);
 }
 
-// The image's largest sample coordinates (`edge3d::image_extent`).
+// The image's largest sample coordinates (`View::sample_extent`).
 fn extent() -> vec2<f32> {
     return vec2<f32>(f32(P.size.x) + 1.0, f32(P.size.y) + 1.0);
 }
