@@ -386,9 +386,17 @@ fn compare_writes_results_with_the_documented_keys() {
             "stats",
             "hashes",
             "agrees",
+            "scene_triangles",
         ] {
             assert!(row.get(key).is_some(), "missing {key}: {row}");
         }
+        // The built-in box has 12 triangles, the sphere 20,480 (README).
+        let triangles = match row["scene"].as_str() {
+            Some("box") => 12,
+            Some("sphere") => 20_480,
+            _ => panic!("a scene of the run: {row}"),
+        };
+        assert_eq!(row["scene_triangles"], triangles, "{row}");
         if row["algorithm"] != "peer-obvhs" {
             assert_eq!(row["agrees"], true, "{row}");
         }
@@ -422,6 +430,14 @@ fn compare_writes_results_with_the_documented_keys() {
     }
     let csv = std::fs::read_to_string(dir.join("results.csv")).expect("results.csv");
     assert_eq!(csv.lines().count(), 11);
+    let header = csv.lines().next().expect("a header");
+    assert!(header.ends_with(",scene_triangles"), "{header}");
+    assert!(
+        csv.lines()
+            .skip(1)
+            .all(|l| l.ends_with(",12") || l.ends_with(",20480")),
+        "{csv}"
+    );
 }
 
 #[test]

@@ -33,6 +33,11 @@ pub struct LoadedScene {
 }
 
 impl LoadedScene {
+    /// How many triangles the scene has.
+    pub fn triangles(&self) -> u64 {
+        self.prepared.scene.mesh.triangles.len() as u64
+    }
+
     pub fn load(
         arg: &str,
         sweep: &Sweep,
@@ -166,6 +171,7 @@ pub fn measure_cell(
                         json!({ "bvh_build_ms": run.build_ms }),
                     );
                 row.coverage_samples = u64::from(width) * u64::from(height);
+                row.scene_triangles = scene.triangles();
                 // Peers find the visible triangle and shade nothing.
                 row.visibility_ms = Some(row.median_ms);
                 Measured {
@@ -305,6 +311,7 @@ fn algorithm_row(
         &out.aa,
         serde_json::to_value(&out.stats).unwrap_or(Value::Null),
     );
+    row.scene_triangles = scene.triangles();
     row.hashes = serde_json::to_value(out.hashes()).unwrap_or(Value::Null);
     row.visibility_ms = Some(super::median(times.visibility).0);
     row.stage_ms = Some(median_stages(&times.stages));

@@ -109,6 +109,9 @@ struct MergeArgs {
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Row {
     pub scene: String,
+    /// The scene's triangles (0 in results written before it was recorded).
+    #[serde(default)]
+    pub scene_triangles: u64,
     pub algorithm: String,
     #[serde(default)]
     pub camera: String,
@@ -183,6 +186,7 @@ impl Row {
         let (median_ms, min_ms, max_ms) = median(times);
         Row {
             scene: scene.to_string(),
+            scene_triangles: 0,
             algorithm: algorithm.to_string(),
             camera: String::new(),
             viewport: String::new(),
@@ -583,7 +587,7 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
     let mut f =
         std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
     let mut text = String::from(
-        "scene,algorithm,camera,viewport,aa,precision,width,height,threads,median_ms,min_ms,max_ms,ratio_to_2dr_brute,predicted_ratio,rays_per_second,triangle_setups,edge_evaluations,bvh_nodes_visited,agrees,pixels_differing_from_3dr_brute,triangle_id_hash,ratio_to_aa_none,ratio_to_f32,shading_samples,coverage_samples,psnr,psnr_edges,flip_mean,visibility_ms,setup_ms,traversal_ms,coverage_ms,resolve_ms,shading_ms,store_ms,speedup,scene_bytes_per_triangle,spans,edge_steps,nodes_culled_outside,nodes_culled_occluded,frusta_split,leaf_setups_reused\n",
+        "scene,algorithm,camera,viewport,aa,precision,width,height,threads,median_ms,min_ms,max_ms,ratio_to_2dr_brute,predicted_ratio,rays_per_second,triangle_setups,edge_evaluations,bvh_nodes_visited,agrees,pixels_differing_from_3dr_brute,triangle_id_hash,ratio_to_aa_none,ratio_to_f32,shading_samples,coverage_samples,psnr,psnr_edges,flip_mean,visibility_ms,setup_ms,traversal_ms,coverage_ms,resolve_ms,shading_ms,store_ms,speedup,scene_bytes_per_triangle,spans,edge_steps,nodes_culled_outside,nodes_culled_occluded,frusta_split,leaf_setups_reused,scene_triangles\n",
     );
     let opt = |v: Option<f64>| v.map_or(String::new(), |x| format!("{x:.4}"));
     for r in rows {
@@ -594,7 +598,7 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
                 .map_or(String::new(), |v| v.to_string())
         };
         text.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{:.0},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{:.3},{:.3},{:.3},{},{},{:.0},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             csv_field(&r.scene),
             csv_field(&r.algorithm),
             csv_field(&r.camera),
@@ -641,6 +645,7 @@ fn write_csv(path: &std::path::Path, rows: &[Row]) -> Result<(), CliError> {
             stat("nodes_culled_occluded"),
             stat("frusta_split"),
             stat("leaf_setups_reused"),
+            r.scene_triangles,
         ));
     }
     f.write_all(text.as_bytes())
