@@ -67,8 +67,8 @@ def measures(rows):
     b_tri = [r["stats"].get("scene_bytes_per_triangle") for a, r in rows.items() if is_cpu(a)]
     b_tri = [b for b in b_tri if b]
     return fastest, {
-        "fastest/es": ms[fastest] / ms["peer-embree-stream"] if "peer-embree-stream" in ms else None,
-        "fastest/gpu": ms[fastest] / ms["gpu-raster"] if "gpu-raster" in ms else None,
+        "fastest/es": ratio(fastest, "peer-embree-stream"),
+        "fastest/gpu": ratio(fastest, "gpu-raster"),
         "frame": max(frame_share(rows[a]) for a in cpu),
         "fig10": max(fig10) if fig10 else None,
         "obvhs/raycast": ratio("peer-obvhs", "raycast"),

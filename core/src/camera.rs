@@ -152,6 +152,17 @@ pub struct View {
     /// Bounds on the planar sample directions over the image, for the
     /// error bounds of edge functions evaluated on it.
     pub(crate) directions: DirectionBounds,
+    /// The largest `|o0| + |x|·|ox| + |y|·|oy|` over the image's samples
+    /// ([`reach`] of the sample origins): what the error bounds of parallel
+    /// projection's edge functions need of them.
+    pub(crate) origin_reach: Vec3,
+}
+
+/// Per component, the largest `|v0| + |x|·|vx| + |y|·|vy|` over the
+/// samples `(x, y) ∈ [−1, x_max] × [−1, y_max]` of an image
+/// ([`View::sample_extent`]; `x_max`, `y_max` ≥ 1).
+fn reach(v0: Vec3, vx: Vec3, vy: Vec3, (x_max, y_max): (f32, f32)) -> Vec3 {
+    v0.abs() + vx.abs() * x_max + vy.abs() * y_max
 }
 
 /// What the error bounds of perspective edge functions need of the sample
@@ -167,12 +178,13 @@ pub(crate) struct DirectionBounds {
 }
 
 impl DirectionBounds {
-    fn of(d0: Vec3, dx: Vec3, dy: Vec3, (x_max, y_max): (f32, f32)) -> DirectionBounds {
+    fn of(d0: Vec3, dx: Vec3, dy: Vec3, extent: (f32, f32)) -> DirectionBounds {
+        let (x_max, y_max) = extent;
         let d = |x: f32, y: f32| (d0 + dx * x + dy * y).abs();
         let largest = (d(-1.0, -1.0).max(d(x_max, -1.0))).max(d(-1.0, y_max).max(d(x_max, y_max)));
         DirectionBounds {
             largest,
-            reach: d0.abs() + dx.abs() * x_max + dy.abs() * y_max,
+            reach: reach(d0, dx, dy, extent),
         }
     }
 }
@@ -245,6 +257,7 @@ impl View {
             half_x,
             sphere: SphereMap::new(camera.viewport, width, height),
             directions: DirectionBounds::of(d0, dx, dy, sample_extent(width, height)),
+            origin_reach: reach(o0, ox, oy, sample_extent(width, height)),
         })
     }
 

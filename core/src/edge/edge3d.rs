@@ -436,8 +436,8 @@ impl Triangle3D {
         let sign = if positive { 1.0 } else { -1.0 };
         // k·(q − o(x, y)) = k·(q − o0) − x·k·ox − y·k·oy, all relative to the eye.
         let toward = |k: Vec3, q: Vec3| [k.dot(q - o0), -k.dot(ox), -k.dot(oy)];
-        let (x_max, y_max) = view.sample_extent();
-        let o_abs = o0.abs() + ox.abs() * x_max + oy.abs() * y_max;
+        // The origins' reach at the vertices' scale (a power of two: exact).
+        let o_abs = view.origin_reach * down;
         let mut coefficient_error = [0.0; 3];
         let edges = [0, 1, 2].map(|i| {
             let (a, b) = (c[(i + 1) % 3], c[(i + 2) % 3]);

@@ -374,7 +374,7 @@ fn orthographic_of<L: Lanes>([c0, c1, c2]: [V<L>; 3], w: [L; 3], view: &View) ->
     let o = Orientation::decided(normal, facing, bound, unscaled(c0, c1, c2));
     // 3. The edges, `d_p × (a − b)` through the midpoint, and their errors.
     let extent = view.sample_extent();
-    let o_abs = view.o0.abs() + view.ox.abs() * extent.0 + view.oy.abs() * extent.1;
+    let o_abs = view.origin_reach;
     let edges = [
         parallel_edge(c1, c2, o.sign, o_abs, view),
         parallel_edge(c2, c0, o.sign, o_abs, view),
