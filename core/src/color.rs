@@ -23,34 +23,39 @@ fn encode_srgb_formula(v: f32) -> u8 {
     (s * 255.0 + 0.5) as u8
 }
 
-/// Buckets of the encoding table over [0, 1].
-const SRGB_BUCKETS: usize = 4096;
+/// Mantissa bits that pick a bucket within its octave: 2⁷ buckets per
+/// octave, each narrower than the transfer function's byte steps there.
+const BUCKET_BITS: u32 = 7;
+/// The bits of a value below its bucket's: where in the bucket it lies.
+const LOW_BITS: u32 = 23 - BUCKET_BITS;
+/// The smallest value with a bucket of its own, 2⁻¹³ (1.2e-4): every value
+/// below it encodes to 0 (byte 1 starts at 1.5e-4), so it shares bucket 0.
+const FIRST_BUCKETED: f32 = 1.0 / 8192.0;
+/// The bit pattern of [`FIRST_BUCKETED`] above [`LOW_BITS`]: bucket 0's.
+const FIRST_BUCKET: u32 = FIRST_BUCKETED.to_bits() >> LOW_BITS;
+/// Buckets of [2⁻¹³, 1) — 13 octaves — and one for `1.0`, past the last.
+const SRGB_BUCKETS: usize = ((1.0f32.to_bits() >> LOW_BITS) - FIRST_BUCKET) as usize + 1;
+/// A bucket's `next` when no byte starts inside it: above every low part.
+const NO_STEP: u32 = 1 << LOW_BITS;
 
-/// [`encode_srgb_formula`] as a table of [`SRGB_BUCKETS`] equal buckets
-/// over [0, 1] (and one for `1.0`, past the last). A bucket is narrower than
-/// the transfer function's smallest byte step (2.4e-4 against 3.0e-4, the
-/// step of its linear part, which is also its steepest), so at most one
-/// byte starts inside it — checked when the table is built: each bucket
-/// holds its first byte and where the next byte starts (`+∞` when not inside
-/// it). The byte starts ("thresholds", the smallest linear value encoding to
-/// each byte) are found by bisection over `f32` bit patterns, which order
-/// non-negative values.
+/// [`encode_srgb_formula`] as a table of buckets over [0, 1] by bit pattern:
+/// the bucket of a value in [2⁻¹³, 1] is its exponent and top
+/// [`BUCKET_BITS`] mantissa bits. A bucket is narrower than the transfer
+/// function's byte step wherever it lies (checked when the table is built:
+/// the steps widen as `v^0.58` and the buckets as `v`, and the top octave's,
+/// 3.9e-3 against 6.0e-3, are the closest), so at most one byte starts inside
+/// it. Each bucket is one word: the byte its first value encodes to (bits
+/// 0–7) and where the next byte starts (bits 8–), as the low [`LOW_BITS`]
+/// bits of that start's pattern ([`NO_STEP`] when no byte starts inside the
+/// bucket) — positive floats order as their bit patterns, so a value reaches
+/// the next byte where its own low bits reach those. One load a channel, from
+/// 6.7 KB that stay in the L1 cache. The byte starts ("thresholds", the
+/// smallest linear value encoding to each byte) are found by bisection over
+/// `f32` bit patterns.
 struct SrgbTable {
-    buckets: [Bucket; SRGB_BUCKETS + 1],
-    /// The buckets' fields apart, as lanes gather them: `next`, and
-    /// `first` as a float.
-    nexts: [f32; SRGB_BUCKETS + 1],
-    firsts: [f32; SRGB_BUCKETS + 1],
+    words: [u32; SRGB_BUCKETS],
     #[cfg(test)]
     thresholds: [f32; 257],
-}
-
-/// One bucket of an [`SrgbTable`]: the byte its first value encodes to, and
-/// the smallest value of the next byte (may lie past the bucket).
-#[derive(Clone, Copy, Default)]
-struct Bucket {
-    next: f32,
-    first: u8,
 }
 
 fn srgb_table() -> &'static SrgbTable {
@@ -70,42 +75,66 @@ fn srgb_table() -> &'static SrgbTable {
             }
             *t = f32::from_bits(lo);
         }
-        let mut buckets = [Bucket::default(); SRGB_BUCKETS + 1];
-        for (i, bucket) in buckets.iter_mut().enumerate() {
-            let first = encode_srgb_formula(i as f32 / SRGB_BUCKETS as f32);
+        // Below bucket 0's first value, byte 0 alone.
+        assert!(thresholds[1] >= FIRST_BUCKETED, "byte 1 starts below 2^-13");
+        let mut words = [0u32; SRGB_BUCKETS];
+        for (i, word) in words.iter_mut().enumerate() {
+            let high = FIRST_BUCKET + i as u32;
+            let start = f32::from_bits(high << LOW_BITS);
+            let first = encode_srgb_formula(start);
             let (next, after) = match usize::from(first) {
                 255 => (f32::INFINITY, f32::INFINITY),
                 b => (thresholds[b + 1], thresholds[b + 2]),
             };
-            // The bucket's values lie below (i + 1) / SRGB_BUCKETS (exact).
+            // Patterns at or above `end` lie in later buckets (`1.0`'s
+            // bucket is the last: nothing above it is looked up).
+            let end = (high + 1) << LOW_BITS;
             assert!(
-                after >= (i + 1) as f32 / SRGB_BUCKETS as f32,
+                after.to_bits() >= end,
                 "sRGB bucket {i} holds two byte steps"
             );
-            *bucket = Bucket { next, first };
+            let next = match next.to_bits() {
+                n if n < end => n & (NO_STEP - 1),
+                _ => NO_STEP,
+            };
+            *word = u32::from(first) | next << 8;
         }
         SrgbTable {
-            buckets,
-            nexts: buckets.map(|b| b.next),
-            firsts: buckets.map(|b| f32::from(b.first)),
+            words,
             #[cfg(test)]
             thresholds,
         }
     })
 }
 
+/// The table's bucket of `bits`, the pattern of a value in [0, 1] (a value
+/// below 2⁻¹³ in bucket 0).
+#[inline(always)]
+fn bucket_of(bits: u32) -> usize {
+    ((bits >> LOW_BITS).max(FIRST_BUCKET) - FIRST_BUCKET) as usize
+}
+
+/// The byte of the value with pattern `bits` in the bucket whose word is `word`.
+#[inline(always)]
+fn byte_in(word: u32, bits: u32) -> u32 {
+    (word & 0xff) + u32::from(bits & (NO_STEP - 1) >= word >> 8)
+}
+
 impl SrgbTable {
     /// [`encode_srgb`] without a branch for its special values: `v ≥ 1`
     /// (`+∞` too) is read as `1`, whose bucket's byte is 255 with no next;
-    /// NaN and `v ≤ 0` land in bucket 0 (the float-to-integer cast
-    /// saturates, NaN to 0) and never reach its next byte's start (`> 0`).
-    /// Two independent loads (one bucket record), no loop.
+    /// NaN, `−0` and `v < 0` are read as `+0` (bucket 0, byte 0).
     #[inline(always)]
     fn encode(&self, v: f32) -> u8 {
-        let v = if v >= 1.0 { 1.0 } else { v };
-        // Exact: scaling by a power of two does not round.
-        let bucket = &self.buckets[((v * SRGB_BUCKETS as f32) as usize).min(SRGB_BUCKETS)];
-        bucket.first + u8::from(v >= bucket.next)
+        let v = if v >= 1.0 {
+            1.0
+        } else if v > 0.0 {
+            v
+        } else {
+            0.0
+        };
+        let bits = v.to_bits();
+        byte_in(self.words[bucket_of(bits)], bits) as u8
     }
 }
 
@@ -141,29 +170,31 @@ pub fn encode_rgb(c: Vec3) -> [u8; 4] {
 }
 
 /// [`encode_rgb`] of eight colours in lanes, channel by channel (red,
-/// green, blue), all in lanes: the clamp and the bucket index (`v ≥ 1` → 1,
-/// then `v · 4096` truncated, a NaN or negative lane to bucket 0, as the
-/// scalar `as usize` gives), the bucket's first byte and next start
-/// gathered, and the byte `first + (v ≥ next)` (a NaN lane: not `≥`). The
-/// three bytes are packed into one word per lane in lanes too (`r + 2⁸g +
-/// 2¹⁶b` is below 2²⁴: exact in f32), so the pixels leave in one store (a
-/// pixel built byte by byte and then copied whole waits for its stores).
+/// green, blue): the clamp in lanes (`v > 1` → 1, then `maxps(v, 0)`, which
+/// gives `+0` for a NaN, `−0` or negative lane, as the scalar path reads
+/// them), then each lane's bucket word gathered (one load a channel) and its
+/// byte `first + (low bits ≥ next)` on the lanes' bit patterns. The three
+/// bytes and the opaque alpha are packed into one word per lane, so the
+/// pixels leave in one store (a pixel built byte by byte and then copied
+/// whole waits for its stores).
 #[inline(always)]
 pub(crate) fn encode_rgb_eight<L: Lanes>(channels: [L; 3]) -> [[u8; 4]; 8] {
-    let table = srgb_table();
+    let words: &[f32] = bytemuck::cast_slice(&srgb_table().words);
     let (one, zero) = (L::splat(1.0), L::splat(0.0));
-    let mut packed = zero;
-    for (v, weight) in channels.into_iter().zip([1.0, 256.0, 65536.0]) {
-        let v = L::select(v.ge(one), one, v);
-        // `maxps` gives its second operand, 0, for a NaN lane.
-        let at = (v * L::splat(SRGB_BUCKETS as f32)).max(zero).truncate();
-        let (next, first) = (L::gather(&table.nexts, at), L::gather(&table.firsts, at));
-        // Small whole numbers, and their weighted sum: exact.
-        packed = packed + (first + L::select(v.ge(next), one, zero)) * L::splat(weight);
-    }
     // Byte order in memory: red first, alpha last.
-    let words = packed.truncate().map(|rgb| (rgb | 0xff00_0000).to_le());
-    bytemuck::cast(words)
+    let mut packed = [0xff00_0000u32; 8];
+    for (v, shift) in channels.into_iter().zip([0, 8, 16]) {
+        // `minps(1, v)`: 1 where `1 < v`, else `v` (a NaN lane too).
+        let v = one.min(v).max(zero);
+        let bits: [u32; 8] = bytemuck::cast(v.to_array());
+        // The table's words travel as float lanes, bit for bit.
+        let bucket: [u32; 8] = bits.map(|b| bucket_of(b) as u32);
+        let word: [u32; 8] = bytemuck::cast(L::gather(words, bucket).to_array());
+        for l in 0..8 {
+            packed[l] |= byte_in(word[l], bits[l]) << shift;
+        }
+    }
+    bytemuck::cast(packed.map(u32::to_le))
 }
 
 #[cfg(test)]
@@ -233,6 +264,25 @@ mod tests {
     #[inline(always)]
     fn encode_group_on<L: Lanes>([r, g, b]: &[[f32; 8]; 3]) -> [[u8; 4]; 8] {
         encode_rgb_eight([L::from_array(*r), L::from_array(*g), L::from_array(*b)])
+    }
+
+    /// Every `f32` in [0, 1] (2³⁰ of them), against the thresholds: the
+    /// table's byte is the number of byte starts at or below the value.
+    #[test]
+    fn the_table_encodes_every_value_in_the_unit_interval() {
+        let table = srgb_table();
+        let mut byte = 0;
+        let mut checked = 0u64;
+        for bits in 0..=1.0f32.to_bits() {
+            let v = f32::from_bits(bits);
+            while v >= table.thresholds[byte + 1] {
+                byte += 1;
+            }
+            assert_eq!(usize::from(table.encode(v)), byte, "{v} ({bits:#x})");
+            checked += 1;
+        }
+        assert_eq!(byte, 255);
+        assert_eq!(checked, u64::from(1.0f32.to_bits()) + 1);
     }
 
     #[test]

@@ -368,7 +368,6 @@ fn shade_single_on<L: Lanes>(
                 Some(eight) => *eight,
                 None => std::array::from_fn(|l| ids.get(c0 + l).map_or(BACKGROUND, |&id| id)),
             };
-            let all = u8::MAX >> (8 - n);
             // Lanes past the row's end hold BACKGROUND: no bit there.
             let surface = (0..8).fold(0u8, |m, l| m | u8::from(ids8[l] != BACKGROUND) << l);
             let colors = &mut colors[c0..c0 + n];
@@ -392,10 +391,16 @@ fn shade_single_on<L: Lanes>(
                 }
             };
             totals.shading_samples += u64::from(done.count_ones());
-            if done == all {
+            // Every lane shaded here or background (a planar view's, which
+            // has a ray through every pixel): one blend and one store.
+            if done | !surface == u8::MAX && view.sphere.is_none() {
+                let blended: [[u8; 4]; 8] = std::array::from_fn(|l| match done >> l & 1 {
+                    1 => encoded[l],
+                    _ => BACKGROUND_COLOR,
+                });
                 match colors.first_chunk_mut::<8>() {
-                    Some(colors) => *colors = encoded,
-                    None => colors.copy_from_slice(&encoded[..n]),
+                    Some(colors) => *colors = blended,
+                    None => colors.copy_from_slice(&blended[..n]),
                 }
                 continue;
             }

@@ -8,9 +8,10 @@
 //! `dot` as `(x·x' + y·y') + z·z'`, `cross`, `1 / sqrt` for normalizing) in the
 //! same order with no fused multiply-add, so a lane's colour is the scalar
 //! colour bit for bit. Lanes that meet one of the scalar path's special cases
-//! (a ray along the plane, degenerate barycentrics, a zero vertex normal, a
-//! normal or light vector that does not normalize, a NaN) are not shaded
-//! here: the caller shades them with [`Shader::shade`].
+//! (a ray along the plane when a light has a position, degenerate
+//! barycentrics, a zero vertex normal, a normal or light vector that does not
+//! normalize, a NaN) are not shaded here: the caller shades them with
+//! [`Shader::shade`].
 
 use glam::{Vec3, Vec4};
 
@@ -242,12 +243,17 @@ impl Shader<'_> {
         let dir = along([view.d0, view.dx, view.dy], x, y);
         let origin = V3::splat(view.eye).add(along([view.o0, view.ox, view.oy], x, y));
 
-        // 3. Where the ray meets the triangle's plane (`plane_distance`).
+        // 3. Where the ray meets the triangle's plane (`plane_distance`):
+        // only a light with a position reads it (elsewhere the colour does
+        // not depend on it, nor on whether the scalar path finds it).
         let normal = p1.sub(p0).cross(p2.sub(p0));
-        let denom = normal.dot(dir);
-        let t = normal.dot(p0.sub(origin)) / denom;
-        done &= !denom.eq(L::splat(0.0)) & finite(t);
-        let point = origin.add(dir.scale(t));
+        let mut point = origin;
+        if self.point_lights {
+            let denom = normal.dot(dir);
+            let t = normal.dot(p0.sub(origin)) / denom;
+            done &= !denom.eq(L::splat(0.0)) & finite(t);
+            point = origin.add(dir.scale(t));
+        }
 
         // 4. The shading normal, facing the ray (`shading_normal`): the face
         // normal is the scene's `face_normals` entry, `normal` normalized (a

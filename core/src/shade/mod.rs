@@ -63,6 +63,9 @@ pub struct Shader<'a> {
     /// Every material's samples are shaded in lanes (`lane_materials` all
     /// true and not empty): no per-sample material read decides it.
     all_in_lanes: bool,
+    /// A light shines from a position: shading needs the shaded point, not
+    /// only the ray's direction.
+    point_lights: bool,
 }
 
 impl<'a> Shader<'a> {
@@ -114,6 +117,8 @@ impl<'a> Shader<'a> {
                 .collect(),
         };
         let all_in_lanes = !lane_materials.is_empty() && lane_materials.iter().all(|&m| m);
+        let point_lights =
+            (light_terms.iter()).any(|(from, _)| matches!(from, LightFrom::Position(_)));
         Shader {
             scene,
             view,
@@ -126,6 +131,7 @@ impl<'a> Shader<'a> {
             lane_materials,
             material_rows,
             all_in_lanes,
+            point_lights,
         }
     }
 
