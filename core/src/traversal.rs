@@ -35,14 +35,25 @@ use crate::trace::{FrustumEvent, NodeOutcome};
 pub(crate) type Setup<'a, T> = fn(&'a [[Vec3; 3]], [u32; 8], u8, &'a View) -> [Option<T>; 8];
 
 /// A leaf triangle as the frusta of one work item met it: its screen box
-/// (`None`: no sample on screen), its setup once a frustum needed it
-/// (`Some(None)`: set up, but seen edge-on), and whether a frustum has
-/// rasterized it since.
+/// (`None`: no sample on screen), whether its setup was made once a frustum
+/// needed it (the setup itself is [`LeafCache::setups`]'), and whether a
+/// frustum has rasterized it since.
 #[derive(Clone, Copy, Debug)]
-struct Leaf<T> {
+struct Leaf {
     rect: Option<PixelRect>,
-    tri: Option<Option<T>>,
+    set_up: bool,
     used: bool,
+}
+
+impl Leaf {
+    /// A triangle just reached, with screen box `rect`: not set up, not used.
+    fn new(rect: Option<PixelRect>) -> Leaf {
+        Leaf {
+            rect,
+            set_up: false,
+            used: false,
+        }
+    }
 }
 
 /// A [`LeafCache`] entry that holds no triangle.
@@ -58,12 +69,18 @@ const NO_LEAF: u32 = u32::MAX;
 /// (a map of every triangle reached cost more than the setups it saved on
 /// a million small triangles). Kept by the worker, emptied per work item:
 /// only the slots, apart from the entries (4 bytes an entry to clear, not a
-/// set-up triangle's 90).
+/// set-up triangle's 64).
 #[derive(Debug)]
 pub(crate) struct LeafCache<T> {
     /// Per entry, the BVH slot it holds ([`NO_LEAF`]: none).
     slots: Vec<u32>,
-    leaves: Vec<Leaf<T>>,
+    leaves: Vec<Leaf>,
+    /// Per entry, its triangle's setup (`None`: seen edge-on), read only
+    /// where its [`Leaf`] says it was made. Apart from the entries' boxes
+    /// and flags: an `Option<Option<Triangle3D>>` beside them took 192 bytes
+    /// an entry (a cache-line-aligned setup and a second line for the
+    /// flags), these 64 and 24.
+    setups: Vec<Option<T>>,
 }
 
 /// Entries of a [`LeafCache`] (a power of two).
@@ -73,14 +90,8 @@ impl<T: Copy> Default for LeafCache<T> {
     fn default() -> Self {
         LeafCache {
             slots: vec![NO_LEAF; LEAF_CACHE],
-            leaves: vec![
-                Leaf {
-                    rect: None,
-                    tri: None,
-                    used: false,
-                };
-                LEAF_CACHE
-            ],
+            leaves: vec![Leaf::new(None); LEAF_CACHE],
+            setups: vec![None; LEAF_CACHE],
         }
     }
 }
@@ -583,24 +594,21 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
             let rects = rects_eight(boxes, &vertices, eight.len(), positions, view, span);
             for l in (0..8).filter(|l| missing >> l & 1 == 1) {
                 self.leaves.slots[entry(l)] = slots[l];
-                self.leaves.leaves[entry(l)] = Leaf {
-                    rect: rects[l],
-                    tri: None,
-                    used: false,
-                };
+                self.leaves.leaves[entry(l)] = Leaf::new(rects[l]);
             }
         }
         let mut wanted = 0u8;
         for l in 0..eight.len() {
             let leaf = &self.leaves.leaves[entry(l)];
-            if leaf.tri.is_none() && leaf.rect.is_some_and(|r| r.intersect(f).is_some()) {
+            if !leaf.set_up && leaf.rect.is_some_and(|r| r.intersect(f).is_some()) {
                 wanted |= 1 << l;
             }
         }
         if wanted != 0 {
             let made = (self.setup)(&scene.slot_corners, slots, wanted, view);
             for l in (0..8).filter(|l| wanted >> l & 1 == 1) {
-                self.leaves.leaves[entry(l)].tri = Some(made[l]);
+                self.leaves.setups[entry(l)] = made[l];
+                self.leaves.leaves[entry(l)].set_up = true;
             }
             self.setups += u64::from(wanted.count_ones());
         }
@@ -624,30 +632,22 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
             let leaf = &mut self.leaves.leaves[entry];
             if std::mem::replace(&mut self.leaves.slots[entry], slot) != slot {
                 let p = &scene.slot_corners[slot as usize];
-                *leaf = Leaf {
-                    rect: boxes.rect(p, scene.slot_vertices[slot as usize], view, span),
-                    tri: None,
-                    used: false,
-                };
+                *leaf = Leaf::new(boxes.rect(p, scene.slot_vertices[slot as usize], view, span));
             }
             let Some(clip) = leaf.rect.and_then(|rect| rect.intersect(f)) else {
                 continue;
             };
-            // By reference: a setup is a cache line or more.
-            let tri = match &mut leaf.tri {
-                Some(tri) => {
-                    if leaf.used {
-                        self.counters.leaf_setups_reused += 1;
-                    }
-                    tri
-                }
-                none => {
-                    self.setups += 1;
-                    none.insert((self.setup)(&scene.slot_corners, [slot; 8], 1, view)[0])
-                }
-            };
+            if !leaf.set_up {
+                self.setups += 1;
+                self.leaves.setups[entry] =
+                    (self.setup)(&scene.slot_corners, [slot; 8], 1, view)[0];
+                leaf.set_up = true;
+            } else if leaf.used {
+                self.counters.leaf_setups_reused += 1;
+            }
             leaf.used = true;
-            let Some(tri) = tri else {
+            // By reference: a setup is a cache line.
+            let Some(tri) = &self.leaves.setups[entry] else {
                 continue;
             };
             let id = scene.slot_triangles[slot as usize];
