@@ -9,9 +9,9 @@
 //! same order with no fused multiply-add, so a lane's colour is the scalar
 //! colour bit for bit. Lanes that meet one of the scalar path's special cases
 //! (a ray along the plane when a light has a position, degenerate
-//! barycentrics, a zero vertex normal, a normal or light vector that does not
-//! normalize, a NaN) are not shaded here: the caller shades them with
-//! [`Shader::shade`].
+//! barycentrics, a zero vertex normal, an interpolated normal or light vector
+//! that does not normalize, a NaN) are not shaded here: the caller shades them
+//! with [`Shader::shade`].
 
 use glam::{Vec3, Vec4};
 
@@ -167,8 +167,9 @@ impl Shader<'_> {
         // first that has one, so that every lane computes on real values).
         // Eight lanes of one triangle (most eights of a scene of large
         // triangles) read it once and broadcast it; other eights read in
-        // lanes: each lane's vertex record, then its three corners and
-        // normals, a row load each ([`Ops::gather_xyz`]) — no branch on how
+        // lanes: each lane's face normal and, where they are needed, its
+        // vertex record, then its three corners and normals, a row load each
+        // ([`Ops::gather_xyz`]) — no branch on how
         // many triangles they hold, so the reads of every lane are on their
         // way at once. Either way every lane holds the same values, so the
         // same colour.
@@ -178,33 +179,45 @@ impl Shader<'_> {
             _ => s.ids[l],
         });
         let uniform = ids.iter().all(|&id| id == first);
+        // The corners only where the barycentrics or the plane distance
+        // read them: the face normal is the scene's, as the scalar path
+        // reads it.
+        let cornered = interpolated || self.point_lights;
         // (No closure around a lane operation: it would be compiled without
         // the lanes' instruction set.)
         let mut normals = [V3::<L>::splat(Vec3::ZERO); 3];
-        let corners = if uniform {
-            let [a, b, c] = mesh.triangles[first as usize].map(|v| v as usize);
-            if interpolated {
-                let n = &mesh.normals;
-                normals = [V3::splat(n[a]), V3::splat(n[b]), V3::splat(n[c])];
+        let mut corners = [V3::<L>::splat(Vec3::ZERO); 3];
+        let facing = if uniform {
+            if cornered {
+                let [a, b, c] = mesh.triangles[first as usize].map(|v| v as usize);
+                if interpolated {
+                    let n = &mesh.normals;
+                    normals = [V3::splat(n[a]), V3::splat(n[b]), V3::splat(n[c])];
+                }
+                let p = &mesh.positions;
+                corners = [V3::splat(p[a]), V3::splat(p[b]), V3::splat(p[c])];
             }
-            let p = &mesh.positions;
-            [V3::splat(p[a]), V3::splat(p[b]), V3::splat(p[c])]
+            V3::splat(prepared.face_normals[first as usize])
         } else {
-            let [a, b, c] = simd::gather_xyz_u32::<L>(mesh.triangles.as_flattened(), 3, ids);
-            if interpolated {
-                let flat = bytemuck::cast_slice(&mesh.normals);
-                normals = [
+            if cornered {
+                let triangles = mesh.triangles.as_flattened();
+                let [a, b, c] = simd::gather_xyz_u32::<L>(triangles, 3, ids);
+                if interpolated {
+                    let flat = bytemuck::cast_slice(&mesh.normals);
+                    normals = [
+                        V3::gathered(flat, 3, a),
+                        V3::gathered(flat, 3, b),
+                        V3::gathered(flat, 3, c),
+                    ];
+                }
+                let flat = bytemuck::cast_slice(&mesh.positions);
+                corners = [
                     V3::gathered(flat, 3, a),
                     V3::gathered(flat, 3, b),
                     V3::gathered(flat, 3, c),
                 ];
             }
-            let flat = bytemuck::cast_slice(&mesh.positions);
-            [
-                V3::gathered(flat, 3, a),
-                V3::gathered(flat, 3, b),
-                V3::gathered(flat, 3, c),
-            ]
+            V3::gathered(bytemuck::cast_slice(&prepared.face_normals), 3, ids)
         };
         let [p0, p1, p2] = corners;
         if interpolated {
@@ -246,20 +259,16 @@ impl Shader<'_> {
         // 3. Where the ray meets the triangle's plane (`plane_distance`):
         // only a light with a position reads it (elsewhere the colour does
         // not depend on it, nor on whether the scalar path finds it).
-        let normal = p1.sub(p0).cross(p2.sub(p0));
         let mut point = origin;
         if self.point_lights {
+            let normal = p1.sub(p0).cross(p2.sub(p0));
             let denom = normal.dot(dir);
             let t = normal.dot(p0.sub(origin)) / denom;
             done &= !denom.eq(L::splat(0.0)) & finite(t);
             point = origin.add(dir.scale(t));
         }
 
-        // 4. The shading normal, facing the ray (`shading_normal`): the face
-        // normal is the scene's `face_normals` entry, `normal` normalized (a
-        // lane where that fails goes scalar).
-        let (facing, ok) = normal.normalized();
-        done &= ok;
+        // 4. The shading normal, facing the ray (`shading_normal`).
         let flip = facing.dot(dir).gt(L::splat(0.0));
         let toward = L::select(flip, L::splat(-1.0), L::splat(1.0));
         let normal = if interpolated {
