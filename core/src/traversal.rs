@@ -36,7 +36,7 @@ pub(crate) type Setup<'a, T> = fn(&'a [[Vec3; 3]], [u32; 8], u8, &'a View) -> [O
 
 /// A leaf triangle as the frusta of one work item met it: its screen box
 /// (`None`: no sample on screen), whether its setup was made once a frustum
-/// needed it (the setup itself is [`LeafCache::setups`]'), and whether a
+/// needed it (the setup itself is in [`LeafCache::setups`]), and whether a
 /// frustum has rasterized it since.
 #[derive(Clone, Copy, Debug)]
 struct Leaf {
