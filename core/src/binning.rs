@@ -176,11 +176,11 @@ fn along_rows<L: Lanes, T: Coverage>(
     let first = L::from_array([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]) + L::splat(x0);
     for y in r.y0..r.y1 {
         let i = tile.index(r.x0, y);
-        count_tests(tile, i, n);
         rows.set_row(y as f32 + 0.5);
         let mut x = first;
         for k in (0..n).step_by(8) {
             let active = first_lanes((n - k) as usize);
+            count_eight(&mut tile.edge_evals, i + k as usize, active);
             let (mask, w) = match how {
                 Samples::Test => rows.sample8(x0 + k as f32, x, active),
                 Samples::Inside => {
@@ -198,11 +198,37 @@ fn along_rows<L: Lanes, T: Coverage>(
     covered
 }
 
-/// Counts a test at each of the `n` pixels from index `i`.
+/// Counts a test at each of the `n` pixels from index `i`, eight at a time.
 #[inline(always)]
 fn count_tests(tile: &mut TileBuffer, i: usize, n: u32) {
-    for count in &mut tile.edge_evals[i..i + n as usize] {
-        *count += 1;
+    for k in (0..n).step_by(8) {
+        count_eight(
+            &mut tile.edge_evals,
+            i + k as usize,
+            first_lanes((n - k) as usize),
+        );
+    }
+}
+
+/// Adds one to `counts[i + l]` for each lane `l` of `lanes`: eight adds
+/// with no branch on how many lanes there are (rows of small triangles are
+/// short, and a loop over their pixels mispredicts its exit at every row),
+/// one by one where the eight would run past the buffer's end.
+#[inline(always)]
+fn count_eight(counts: &mut [u32], i: usize, lanes: u8) {
+    match counts.get_mut(i..i + 8) {
+        Some(eight) => {
+            for (l, count) in eight.iter_mut().enumerate() {
+                *count += u32::from(lanes >> l & 1);
+            }
+        }
+        None => {
+            let mut left = lanes;
+            while left != 0 {
+                counts[i + left.trailing_zeros() as usize] += 1;
+                left &= left - 1;
+            }
+        }
     }
 }
 
@@ -599,6 +625,30 @@ mod tests {
     use crate::aa::{AaMode, SamplePattern};
     use crate::edge::{ScreenVertex, Triangle2D};
     use crate::simd::Portable;
+
+    /// `count_eight` adds one at exactly the lanes it is given, eight at once
+    /// or, where the eight would run past the buffer's end, one by one: the
+    /// counts after random groups are those of adding lane by lane.
+    #[test]
+    fn counting_eight_adds_one_at_each_given_lane() {
+        let mut rng = fastrand::Rng::with_seed(5);
+        let (mut counts, mut expected) = (vec![0u32; 21], vec![0u32; 21]);
+        let (mut groups, mut at_end) = (0, 0);
+        for _ in 0..2_000 {
+            let i = rng.usize(0..counts.len());
+            // Lanes past the buffer's end are never given.
+            let lanes = rng.u8(..) & first_lanes(counts.len() - i);
+            count_eight(&mut counts, i, lanes);
+            for l in (0..8).filter(|l| lanes >> l & 1 == 1) {
+                expected[i + l] += 1;
+            }
+            groups += 1;
+            at_end += usize::from(i + 8 > counts.len());
+        }
+        assert_eq!(counts, expected);
+        assert_eq!(groups, 2_000);
+        assert!(at_end > 300, "{at_end} groups ran past the end");
+    }
 
     /// The small-triangle path decides and writes every sample as the
     /// general row path does: random small triangles, with their neighbours

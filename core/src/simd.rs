@@ -608,15 +608,21 @@ pub(crate) fn prefetch<T: ?Sized>(value: &T) {
         use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
         let first = (value as *const T).cast::<i8>();
         let size = size_of_val(value);
+        // SAFETY: `_mm_prefetch` needs SSE, which every x86-64 CPU has; it
+        // is a hint that neither reads nor faults, whatever the address (and
+        // these lie within a live reference).
+        let hint =
+            |offset: usize| unsafe { _mm_prefetch::<_MM_HINT_T0>(first.wrapping_add(offset)) };
         // A line every 64 bytes and the last byte's: every line the value
-        // touches holds one of them.
-        let last = size.saturating_sub(1);
-        for offset in (0..size).step_by(64).chain([last]) {
-            // SAFETY: `_mm_prefetch` needs SSE, which every x86-64 CPU has;
-            // it is a hint that neither reads nor faults, whatever the
-            // address (and this one lies within a live reference).
-            unsafe { _mm_prefetch::<_MM_HINT_T0>(first.wrapping_add(offset)) };
+        // touches holds one of them. (A counted loop: for a sized value the
+        // count is a constant and the loop unrolls into bare prefetches,
+        // where `(0..size).step_by(64).chain(..)` kept an iterator's state
+        // and branches in every call: 4% of a dragon frame's instructions
+        // under `3dr-brute`.)
+        for line in 0..size.div_ceil(64) {
+            hint(line * 64);
         }
+        hint(size.saturating_sub(1));
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = value;
