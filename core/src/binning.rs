@@ -693,6 +693,27 @@ mod tests {
         assert!(at_end > 300, "{at_end} groups ran past the end");
     }
 
+    /// A random triangle of about 0.5, 1.5 or 3 pixels (by `id`) inside a
+    /// 16×16 tile, with its box under `pattern`; `None` where it has no area
+    /// or no samples.
+    fn small_triangle(
+        rng: &mut fastrand::Rng,
+        id: u32,
+        pattern: &SamplePattern,
+    ) -> Option<(Triangle2D, PixelRect)> {
+        let centre = [1.0 + 14.0 * rng.f32(), 1.0 + 14.0 * rng.f32()];
+        let size = [0.5, 1.5, 3.0][id as usize % 3];
+        let v: [ScreenVertex; 3] = std::array::from_fn(|_| ScreenVertex {
+            x: centre[0] + size * (rng.f32() - 0.5),
+            y: centre[1] + size * (rng.f32() - 0.5),
+            q: 1.0 / (1.0 + rng.f32()),
+        });
+        let tri = Triangle2D::setup(&v, false, 16, 16)?;
+        let [x0, y0, x1, y1] = tri.bounds;
+        let r = PixelRect::from_bounds(x0, y0, x1, y1, 16, 16, pattern.span)?;
+        Some((tri, r))
+    }
+
     /// The queue of small triangles leaves every buffer as the row path
     /// does: random small triangles of every box shape (one row included),
     /// queued and flushed at the end, against the same triangles sampled
@@ -711,18 +732,7 @@ mod tests {
             );
             let mut small = Vec::new();
             for id in 0..3000u32 {
-                let centre = [1.0 + 14.0 * rng.f32(), 1.0 + 14.0 * rng.f32()];
-                let size = [0.5, 1.5, 3.0][id as usize % 3];
-                let v: [ScreenVertex; 3] = std::array::from_fn(|_| ScreenVertex {
-                    x: centre[0] + size * (rng.f32() - 0.5),
-                    y: centre[1] + size * (rng.f32() - 0.5),
-                    q: 1.0 / (1.0 + rng.f32()),
-                });
-                let Some(tri) = Triangle2D::setup(&v, false, 16, 16) else {
-                    continue;
-                };
-                let [x0, y0, x1, y1] = tri.bounds;
-                let Some(r) = PixelRect::from_bounds(x0, y0, x1, y1, 16, 16, pattern.span) else {
+                let Some((tri, r)) = small_triangle(&mut rng, id, &pattern) else {
                     continue;
                 };
                 if SmallQueue::<&Triangle2D>::takes(&rows, r) {
@@ -783,18 +793,7 @@ mod tests {
             let mut rows = TileBuffer::new(rect, &pattern, &[]);
             small.push(0);
             for id in 0..3000 {
-                let centre = [1.0 + 14.0 * rng.f32(), 1.0 + 14.0 * rng.f32()];
-                let size = [0.5, 1.5, 3.0][id as usize % 3];
-                let v: [ScreenVertex; 3] = std::array::from_fn(|_| ScreenVertex {
-                    x: centre[0] + size * (rng.f32() - 0.5),
-                    y: centre[1] + size * (rng.f32() - 0.5),
-                    q: 1.0 / (1.0 + rng.f32()),
-                });
-                let Some(tri) = Triangle2D::setup(&v, false, 16, 16) else {
-                    continue;
-                };
-                let [x0, y0, x1, y1] = tri.bounds;
-                let Some(r) = PixelRect::from_bounds(x0, y0, x1, y1, 16, 16, pattern.span) else {
+                let Some((tri, r)) = small_triangle(&mut rng, id, &pattern) else {
                     continue;
                 };
                 if !(r.height() > 1 && is_small(&fast, r)) {
