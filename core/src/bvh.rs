@@ -332,18 +332,18 @@ impl SceneBvh {
 /// obvhs's traversal mask for the children of `node` whose bits are set in
 /// `hits` (bit `i` for child slot `i`).
 #[inline(always)]
-fn child_mask(node: &CwBvhNode, mut hits: u32, oct_inv4: u32) -> u32 {
+fn child_mask(node: &CwBvhNode, hits: u32, oct_inv4: u32) -> u32 {
     if hits == 0 {
         return 0;
     }
+    // Every slot, hit or not, with no branch: how many children a packet
+    // hits is unpredictable, and a loop over them mispredicts its exit. An
+    // empty slot's bits are zero (its meta byte is), so it adds nothing.
     let (child_bits8, bit_index8) = node.get_child_and_index_bits(oct_inv4);
     let mut mask = 0;
-    while hits != 0 {
-        let child = hits.trailing_zeros() as usize;
-        hits &= hits - 1;
-        if !node.is_child_empty(child) {
-            mask |= extract_byte64(child_bits8, child) << extract_byte64(bit_index8, child);
-        }
+    for child in 0..8 {
+        let bits = extract_byte64(child_bits8, child) * (hits >> child & 1);
+        mask |= bits << extract_byte64(bit_index8, child);
     }
     mask
 }

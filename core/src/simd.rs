@@ -537,6 +537,28 @@ pub(crate) fn first_lanes(n: usize) -> u8 {
     ((1u16 << n.min(8)) - 1) as u8
 }
 
+/// Adds one to `counts[i + l]` for each lane `l` of `lanes`: eight adds
+/// with no branch on how many lanes there are (rows of small triangles are
+/// short, and a loop over their pixels mispredicts its exit at every row),
+/// one by one where the eight would run past the buffer's end.
+#[inline(always)]
+pub(crate) fn count_eight(counts: &mut [u32], i: usize, lanes: u8) {
+    match counts.get_mut(i..i + 8) {
+        Some(eight) => {
+            for (l, count) in eight.iter_mut().enumerate() {
+                *count += u32::from(lanes >> l & 1);
+            }
+        }
+        None => {
+            let mut left = lanes;
+            while left != 0 {
+                counts[i + left.trailing_zeros() as usize] += 1;
+                left &= left - 1;
+            }
+        }
+    }
+}
+
 /// A chunk of one to eight ids as eight lanes' worth: the chunk itself
 /// when it is full (read in one load from where it lies: an array built
 /// lane by lane would be read back before its stores land), else a copy
@@ -631,6 +653,30 @@ pub(crate) fn prefetch<T: ?Sized>(value: &T) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `count_eight` adds one at exactly the lanes it is given, eight at once
+    /// or, where the eight would run past the buffer's end, one by one: the
+    /// counts after random groups are those of adding lane by lane.
+    #[test]
+    fn counting_eight_adds_one_at_each_given_lane() {
+        let mut rng = fastrand::Rng::with_seed(5);
+        let (mut counts, mut expected) = (vec![0u32; 21], vec![0u32; 21]);
+        let (mut groups, mut at_end) = (0, 0);
+        for _ in 0..2_000 {
+            let i = rng.usize(0..counts.len());
+            // Lanes past the buffer's end are never given.
+            let lanes = rng.u8(..) & first_lanes(counts.len() - i);
+            count_eight(&mut counts, i, lanes);
+            for l in (0..8).filter(|l| lanes >> l & 1 == 1) {
+                expected[i + l] += 1;
+            }
+            groups += 1;
+            at_end += usize::from(i + 8 > counts.len());
+        }
+        assert_eq!(counts, expected);
+        assert_eq!(groups, 2_000);
+        assert!(at_end > 300, "{at_end} groups ran past the end");
+    }
 
     /// What a gather reads: single floats, rows of three of floats and
     /// of `u32` bits, rows of four.

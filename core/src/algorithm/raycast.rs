@@ -17,7 +17,7 @@ use crate::edge::{Coverage, Stored};
 use crate::framebuffer::{BACKGROUND, Fragment, Framebuffer, TileBuffer, wins_depth_test};
 use crate::prepared::PreparedScene;
 use crate::prepared::is_see_through;
-use crate::simd::{self, Lanes, Portable};
+use crate::simd::{self, Lanes, Portable, count_eight};
 use crate::stats::Stats;
 use crate::trace::NodeOutcome;
 
@@ -33,6 +33,8 @@ const _: () = assert!((BLOCK * BLOCK) as usize == PACKET);
 /// 8-lane halves of a group of rays.
 const HALVES: usize = PACKET.div_ceil(8);
 const _: () = assert!(HALVES == 2 && BLOCK == 4);
+// The halves of the largest packet (sixteen groups) fit a `u32`, bit per half.
+const _: () = assert!(16 * HALVES <= 32);
 /// Each lane's column and row in its group's 4×4 block, per half.
 const LANE_X: [f32; 8] = [0.0, 1.0, 2.0, 3.0, 0.0, 1.0, 2.0, 3.0];
 const LANE_Y: [[f32; 8]; HALVES] = [
@@ -212,10 +214,10 @@ fn cast_band_on<L: Lanes, T: Stored, const G: usize>(
                 let fragments = &mut tile.fragments;
                 let entered = trace_nodes.as_mut();
                 nodes += scene.bvh.walk_packet::<L, G>(&packet, entered, |k, cull| {
-                    // The box first: most leaf triangles miss a packet's block.
-                    let Some((rect, id)) = setups.boxes[k as usize].get() else {
-                        return false;
-                    };
+                    // The box first: most leaf triangles miss a packet's
+                    // block. (A triangle with nothing to test has an empty
+                    // box, which no block meets: one branch for both.)
+                    let (rect, id) = setups.boxes[k as usize].unchecked();
                     if G > 1 && !overlaps(rect, x, y, side) {
                         return false;
                     }
@@ -234,39 +236,40 @@ fn cast_band_on<L: Lanes, T: Stored, const G: usize>(
                     let tri = setups.bind(tri, k as usize, id);
                     let see_through = is_see_through(opacity, id);
                     let mut moved = false;
-                    for g in 0..G {
-                        for half in 0..HALVES {
-                            let active = (inside[g] >> (8 * half)) as u8;
-                            if active == 0 {
-                                continue;
-                            }
-                            let mut lanes = active;
-                            while lanes != 0 {
-                                tested[g][half * 8 + lanes.trailing_zeros() as usize] += 1;
-                                lanes &= lanes - 1;
-                            }
-                            let (xs, ys) = (xs[g][half], ys[g][half]);
-                            let (mut hits, depth) = tri.sample_points8::<L>(xs, ys, active);
-                            while hits != 0 {
-                                let l = hits.trailing_zeros() as usize;
-                                hits &= hits - 1;
-                                let (w, lane) = (depth[l], half * 8 + l);
-                                covered[g][lane] += 1;
-                                if see_through {
-                                    let (px, py) = lane_pixel(corner[g], lane);
-                                    let i = (py - y0) as usize * width + (px - x0) as usize;
-                                    fragments.push(Fragment {
-                                        sample: (s * pixels + i) as u32,
-                                        w,
-                                        id,
-                                    });
-                                } else if wins_depth_test(w, id, best_w[g][lane], best_id[g][lane])
-                                {
-                                    (best_w[g][lane], best_id[g][lane]) = (w, id);
-                                    best_slot[g][lane] = k;
-                                    cull[g][lane] = w * CULL_MARGIN;
-                                    moved = true;
-                                }
+                    // The groups' halves with lanes to test, bit per half: a
+                    // loop over those alone (a tiny triangle meets one or
+                    // two), not an unpredictable branch on each of them.
+                    let mut halves = 0u32;
+                    for h in 0..G * HALVES {
+                        let active = (inside[h / HALVES] >> (8 * (h % HALVES))) as u8;
+                        halves |= u32::from(active != 0) << h;
+                    }
+                    while halves != 0 {
+                        let h = halves.trailing_zeros() as usize;
+                        halves &= halves - 1;
+                        let (g, half) = (h / HALVES, h % HALVES);
+                        let active = (inside[g] >> (8 * half)) as u8;
+                        count_eight(tested.as_flattened_mut(), h * 8, active);
+                        let (xs, ys) = (xs[g][half], ys[g][half]);
+                        let (mut hits, depth) = tri.sample_points8::<L>(xs, ys, active);
+                        count_eight(covered.as_flattened_mut(), h * 8, hits);
+                        while hits != 0 {
+                            let l = hits.trailing_zeros() as usize;
+                            hits &= hits - 1;
+                            let (w, lane) = (depth[l], half * 8 + l);
+                            if see_through {
+                                let (px, py) = lane_pixel(corner[g], lane);
+                                let i = (py - y0) as usize * width + (px - x0) as usize;
+                                fragments.push(Fragment {
+                                    sample: (s * pixels + i) as u32,
+                                    w,
+                                    id,
+                                });
+                            } else if wins_depth_test(w, id, best_w[g][lane], best_id[g][lane]) {
+                                (best_w[g][lane], best_id[g][lane]) = (w, id);
+                                best_slot[g][lane] = k;
+                                cull[g][lane] = w * CULL_MARGIN;
+                                moved = true;
                             }
                         }
                     }
@@ -496,32 +499,29 @@ fn lost_coverage<T: Stored>(
 /// Does `rect` share a pixel with the `side`² block at `(x, y)`?
 #[inline(always)]
 fn overlaps(rect: PixelRect, x: u32, y: u32, side: u32) -> bool {
-    rect.x0 < x + side && x < rect.x1 && rect.y0 < y + side && y < rect.y1
+    // (`&`, not `&&`: one branch on the answer, not one per side.)
+    (rect.x0 < x + side) & (x < rect.x1) & (rect.y0 < y + side) & (y < rect.y1)
 }
 
 /// The lanes of the 4×4 block at `(x, y)` whose pixel lies in `rect` (bit
 /// `l` for pixel `(x + l % 4, y + l / 4)`).
 #[inline(always)]
 fn block_mask(rect: PixelRect, x: u32, y: u32) -> u16 {
+    // The columns' bits copied into the rows', with no branch: a row's
+    // four bits times one at each row's first bit (`0x1111` spreads a full
+    // row into all four; the copies never overlap, so nothing carries).
     let columns = span_bits(rect.x0, rect.x1, x);
     let rows = span_bits(rect.y0, rect.y1, y);
-    let mut mask = 0;
-    for r in 0..BLOCK {
-        if rows >> r & 1 == 1 {
-            mask |= columns << (BLOCK * r);
-        }
-    }
-    mask
+    let spread = (0..BLOCK).fold(0, |m, r| m | (rows >> r & 1) << (BLOCK * r));
+    columns * spread
 }
 
 /// Bits `i < BLOCK` with `from + i` in `lo..hi`.
 #[inline(always)]
 fn span_bits(lo: u32, hi: u32, from: u32) -> u16 {
     let start = lo.saturating_sub(from).min(BLOCK);
-    let end = hi.saturating_sub(from).min(BLOCK);
-    if start >= end {
-        return 0;
-    }
+    // (An empty span, `end ≤ start`, gives no bits: no branch on it.)
+    let end = hi.saturating_sub(from).clamp(start, BLOCK);
     (1u16 << end) - (1u16 << start)
 }
 

@@ -83,13 +83,21 @@ impl ItemBox {
     /// The box and the triangle's id, or `None` when there is nothing to test.
     #[inline(always)]
     pub(crate) fn get(self) -> Option<(PixelRect, u32)> {
+        (self.x0 < self.x1).then_some(self.unchecked())
+    }
+
+    /// The box and the triangle's id with no branch: the box of
+    /// [`ItemBox::NONE`] is empty, so a caller that intersects it with its
+    /// pixels rejects it there.
+    #[inline(always)]
+    pub(crate) fn unchecked(self) -> (PixelRect, u32) {
         let rect = PixelRect::new(
             self.x0.into(),
             self.y0.into(),
             self.x1.into(),
             self.y1.into(),
         );
-        (self.x0 < self.x1).then_some((rect, self.id))
+        (rect, self.id)
     }
 }
 
