@@ -221,10 +221,10 @@ fn cast_band_on<L: Lanes, T: Stored, const G: usize>(
                     if G > 1 && !overlaps(rect, x, y, side) {
                         return false;
                     }
-                    let mut inside = [0u16; G];
+                    let mut inside = group_masks::<G>(rect, x, y);
                     let mut any = 0;
                     for g in 0..G {
-                        inside[g] = cast[g] & block_mask(rect, corner[g].0, corner[g].1);
+                        inside[g] &= cast[g];
                         any |= inside[g];
                     }
                     if any == 0 {
@@ -240,9 +240,9 @@ fn cast_band_on<L: Lanes, T: Stored, const G: usize>(
                     // loop over those alone (a tiny triangle meets one or
                     // two), not an unpredictable branch on each of them.
                     let mut halves = 0u32;
-                    for h in 0..G * HALVES {
-                        let active = (inside[h / HALVES] >> (8 * (h % HALVES))) as u8;
-                        halves |= u32::from(active != 0) << h;
+                    for (c, four) in inside.chunks(4).enumerate() {
+                        let groups = four.iter().rev().fold(0, |v, &m| v << 16 | u64::from(m));
+                        halves |= nonzero_bytes(groups) << (8 * c);
                     }
                     while halves != 0 {
                         let h = halves.trailing_zeros() as usize;
@@ -507,22 +507,48 @@ fn overlaps(rect: PixelRect, x: u32, y: u32, side: u32) -> bool {
 /// `l` for pixel `(x + l % 4, y + l / 4)`).
 #[inline(always)]
 fn block_mask(rect: PixelRect, x: u32, y: u32) -> u16 {
-    // The columns' bits copied into the rows', with no branch: a row's
-    // four bits times one at each row's first bit (`0x1111` spreads a full
-    // row into all four; the copies never overlap, so nothing carries).
-    let columns = span_bits(rect.x0, rect.x1, x);
-    let rows = span_bits(rect.y0, rect.y1, y);
-    let spread = (0..BLOCK).fold(0, |m, r| m | (rows >> r & 1) << (BLOCK * r));
-    columns * spread
+    group_masks::<1>(rect, x, y)[0]
 }
 
-/// Bits `i < BLOCK` with `from + i` in `lo..hi`.
+/// [`block_mask`] of each of the `G` groups of the square packet at
+/// `(x, y)` (group `g` at `(x, y) + BLOCK · (g % √G, g / √G)`), from one
+/// span of the packet's columns and one of its rows, with no branch: each
+/// of a group's four row bits moves to the first bit of its row in the
+/// mask, and the product with the group's four column bits copies those
+/// into every row the rect holds (the copies never overlap: no carries).
 #[inline(always)]
-fn span_bits(lo: u32, hi: u32, from: u32) -> u16 {
-    let start = lo.saturating_sub(from).min(BLOCK);
+fn group_masks<const G: usize>(rect: PixelRect, x: u32, y: u32) -> [u16; G] {
+    let side = G.isqrt() as u32;
+    let columns = span_bits(rect.x0, rect.x1, x, BLOCK * side);
+    let rows = span_bits(rect.y0, rect.y1, y, BLOCK * side);
+    std::array::from_fn(|g| {
+        let (gx, gy) = (g as u32 % side, g as u32 / side);
+        let four = |span: u32, at: u32| (span >> (BLOCK * at) & 0xf) as u16;
+        let rows = four(rows, gy);
+        let spread = (rows | rows << 3 | rows << 6 | rows << 9) & 0x1111;
+        four(columns, gx) * spread
+    })
+}
+
+/// Bits `i < width` (at most 16) with `from + i` in `lo..hi`.
+#[inline(always)]
+fn span_bits(lo: u32, hi: u32, from: u32, width: u32) -> u32 {
+    let start = lo.saturating_sub(from).min(width);
     // (An empty span, `end ≤ start`, gives no bits: no branch on it.)
-    let end = hi.saturating_sub(from).clamp(start, BLOCK);
-    (1u16 << end) - (1u16 << start)
+    let end = hi.saturating_sub(from).clamp(start, width);
+    (1 << end) - (1 << start)
+}
+
+/// Bit `b` for each byte `b` of `x` that is not zero, with no branch.
+#[inline(always)]
+fn nonzero_bytes(x: u64) -> u32 {
+    const LOW: u64 = 0x7f7f_7f7f_7f7f_7f7f;
+    // Each byte's top bit: set where its low seven bits add up past 0x7f
+    // (no carry leaves the byte) or where it was set.
+    let tops = (((x & LOW) + LOW) | x) & !LOW;
+    // Byte `b`'s top bit, shifted to bit `8b`, times the magic lands on bit
+    // `56 + b` alone (every other product on a bit of its own: no carries).
+    ((tops >> 7).wrapping_mul(0x0102_0408_1020_4080) >> 56) as u32
 }
 
 #[cfg(test)]
@@ -562,6 +588,56 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// Every byte of random words, zero or not (about half of each), is
+    /// named by its bit.
+    #[test]
+    fn nonzero_bytes_name_every_byte_that_is_not_zero() {
+        let mut rng = fastrand::Rng::with_seed(6);
+        let mut zeros = 0;
+        for _ in 0..20_000 {
+            let bytes: [u8; 8] = std::array::from_fn(|_| match rng.bool() {
+                true => 0,
+                false => rng.u8(1..),
+            });
+            let expected = (0..8).fold(0, |m, b| m | u32::from(bytes[b] != 0) << b);
+            assert_eq!(
+                nonzero_bytes(u64::from_le_bytes(bytes)),
+                expected,
+                "{bytes:?}"
+            );
+            zeros += expected.count_zeros() - 24;
+        }
+        assert!((70_000..90_000).contains(&zeros), "{zeros} zero bytes");
+    }
+
+    /// Each group's mask of a packet is its block's mask at its corner:
+    /// packets of one, four and sixteen groups.
+    #[test]
+    fn group_masks_are_the_blocks_masks() {
+        fn check<const G: usize>(rng: &mut fastrand::Rng) -> u32 {
+            let (x0, y0) = (rng.u32(0..40), rng.u32(0..40));
+            let rect = PixelRect::new(x0, y0, x0 + rng.u32(0..20), y0 + rng.u32(0..20));
+            let (x, y) = (rng.u32(0..48), rng.u32(0..48));
+            let side = G.isqrt() as u32;
+            let masks = group_masks::<G>(rect, x, y);
+            for (g, &mask) in masks.iter().enumerate() {
+                let (gx, gy) = (x + BLOCK * (g as u32 % side), y + BLOCK * (g as u32 / side));
+                assert_eq!(
+                    mask,
+                    block_mask(rect, gx, gy),
+                    "{rect:?} at ({x}, {y}), group {g}"
+                );
+            }
+            masks.iter().map(|m| m.count_ones()).sum()
+        }
+        let mut rng = fastrand::Rng::with_seed(8);
+        let mut lanes = 0;
+        for _ in 0..5_000 {
+            lanes += check::<1>(&mut rng) + check::<4>(&mut rng) + check::<16>(&mut rng);
+        }
+        assert!(lanes > 40_000, "{lanes} lanes inside");
     }
 
     #[test]
