@@ -147,13 +147,11 @@ fn cast_band_on<L: Lanes, T: Stored, const G: usize>(
         for x in (tile.x0..tile.x1).step_by(side as usize) {
             // Each group's corner, and its pixels inside the tile (bit per
             // lane; all sixteen but at the band's right and bottom edges).
-            let mut corner = [(0, 0); G];
-            let mut inside_tile = [0u16; G];
-            for g in 0..G {
+            let corner: [(u32, u32); G] = std::array::from_fn(|g| {
                 let (gx, gy) = (g as u32 % columns, g as u32 / columns);
-                corner[g] = (x + gx * BLOCK, y + gy * BLOCK);
-                inside_tile[g] = block_mask(tile.rect(), corner[g].0, corner[g].1);
-            }
+                (x + gx * BLOCK, y + gy * BLOCK)
+            });
+            let inside_tile = group_masks::<G>(tile.rect(), x, y);
             for (s, &[ox, oy]) in pattern.positions[..stored].iter().enumerate() {
                 // Each group's samples as two 8-lane halves (lane `l` at
                 // pixel `corner + (l % 4, l / 4)`: `px as f32 + ox`, exact
@@ -503,15 +501,9 @@ fn overlaps(rect: PixelRect, x: u32, y: u32, side: u32) -> bool {
     (rect.x0 < x + side) & (x < rect.x1) & (rect.y0 < y + side) & (y < rect.y1)
 }
 
-/// The lanes of the 4×4 block at `(x, y)` whose pixel lies in `rect` (bit
-/// `l` for pixel `(x + l % 4, y + l / 4)`).
-#[inline(always)]
-fn block_mask(rect: PixelRect, x: u32, y: u32) -> u16 {
-    group_masks::<1>(rect, x, y)[0]
-}
-
-/// [`block_mask`] of each of the `G` groups of the square packet at
-/// `(x, y)` (group `g` at `(x, y) + BLOCK · (g % √G, g / √G)`), from one
+/// Per group of the square packet at `(x, y)` (group `g` at
+/// `(x, y) + BLOCK · (g % √G, g / √G)`), the lanes of its 4×4 block whose
+/// pixel lies in `rect` (bit `l` for pixel `corner + (l % 4, l / 4)`), from one
 /// span of the packet's columns and one of its rows, with no branch: each
 /// of a group's four row bits moves to the first bit of its row in the
 /// mask, and the product with the group's four column bits copies those
@@ -554,6 +546,11 @@ fn nonzero_bytes(x: u64) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The lanes of the 4×4 block at `(x, y)` whose pixel lies in `rect`.
+    fn block_mask(rect: PixelRect, x: u32, y: u32) -> u16 {
+        group_masks::<1>(rect, x, y)[0]
+    }
 
     /// The packet's directions, eight lanes at a time, are `View::direction`
     /// bit for bit (portable lanes; the AVX2 ones round alike, see `simd`).
