@@ -131,14 +131,7 @@ fn resolve_tile(tile: &TileBuffer, out: &mut TilePlanes) -> TileTotals {
     if stored == 1 {
         stream::copy_rows(&mut out.coverage_writes, &tile.coverage_writes[..pixels]);
     }
-    // The counters, from the tile (in cache): plain reductions, which vectorize.
-    let evals = &tile.edge_evals[..pixels];
-    let edge_evaluations = evals.iter().map(|&e| u64::from(e)).sum::<u64>();
-    let max_edge_evals = evals.iter().copied().max().unwrap_or(0);
-    let mut histogram = CoverageHistogram::default();
-    for layer in tile.coverage_writes.chunks_exact(pixels).take(stored) {
-        histogram += CoverageHistogram::of(layer);
-    }
+    let (edge_evaluations, max_edge_evals, histogram) = tile_counts(tile);
     let summed_writes = stored > 1 && !out.coverage_writes.is_empty();
     for (r, start) in (0..pixels).step_by(width).enumerate() {
         if summed_writes {
@@ -174,6 +167,32 @@ fn resolve_tile(tile: &TileBuffer, out: &mut TilePlanes) -> TileTotals {
         max_edge_evals,
         ..TileTotals::default()
     }
+}
+
+simd::dispatch! {
+    /// The counters of `tile`, from the tile (in cache): its edge
+    /// evaluations, the most at one pixel, and the histogram of its stored
+    /// samples' coverage writes — plain reductions, which vectorize (to
+    /// AVX2's width where the CPU has it).
+    fn tile_counts<>(tile: &TileBuffer) -> (u64, u32, CoverageHistogram) => tile_counts_on
+}
+
+/// [`tile_counts`], compiled for lanes `L`.
+#[inline(always)]
+fn tile_counts_on<L: Lanes>(tile: &TileBuffer) -> (u64, u32, CoverageHistogram) {
+    let pixels = tile.pixels;
+    let evals = &tile.edge_evals[..pixels];
+    let edge_evaluations = evals.iter().map(|&e| u64::from(e)).sum::<u64>();
+    let max_edge_evals = evals.iter().copied().max().unwrap_or(0);
+    let mut histogram = CoverageHistogram::default();
+    for layer in tile
+        .coverage_writes
+        .chunks_exact(pixels)
+        .take(tile.pattern.stored)
+    {
+        histogram += CoverageHistogram::of(layer);
+    }
+    (edge_evaluations, max_edge_evals, histogram)
 }
 
 /// A rendered tile into the frame: [`resolve_tile`], then [`shade_tile`];
@@ -324,109 +343,160 @@ fn shade_tile(tile: &TileBuffer, view: &View, shader: &Shader, out: &mut TilePla
     totals
 }
 
-simd::dispatch! {
-    /// [`shade_tile`] of a tile with one sample per pixel and no see-through
-    /// fragments (no anti-aliasing, opaque surfaces): each pixel's colour is
-    /// its sample's, exactly as the general path computes it, without its
-    /// per-sample bookkeeping — eight pixels of a row at a time where the
-    /// view is planar and the material allows ([`Shader::shade_eight`]).
-    fn shade_single<>(
-        tile: &TileBuffer,
-        view: &View,
-        shader: &Shader,
-        out: &mut TilePlanes,
-        totals: &mut TileTotals,
-    ) -> () => shade_single_on
-}
-
-/// [`shade_single`] on lanes `L`.
-#[inline(always)]
-fn shade_single_on<L: Lanes>(
+/// [`shade_tile`] of a tile with one sample per pixel and no see-through
+/// fragments (no anti-aliasing, opaque surfaces): each pixel's colour is
+/// its sample's, exactly as the general path computes it, without its
+/// per-sample bookkeeping ([`shade_rows`]), written into the frame past the
+/// cache (the frame's colours are not read again while they would be cached).
+fn shade_single(
     tile: &TileBuffer,
     view: &View,
     shader: &Shader,
     out: &mut TilePlanes,
     totals: &mut TileTotals,
 ) {
+    stream::streamed(&mut out.color, |colors| {
+        shade_rows(tile, view, shader, colors, totals)
+    });
+}
+
+/// Pixels a row of [`shade_rows`] is shaded in at a time, into a buffer
+/// that stays in the L1 cache, before that piece of the row is written out.
+const ROW_PIECE: usize = 256;
+
+simd::dispatch! {
+    /// [`shade_single`]'s colours, row by row, eight pixels of a row at a
+    /// time where the view is planar and the material allows
+    /// ([`Shader::shade_eight`]).
+    fn shade_rows<>(
+        tile: &TileBuffer,
+        view: &View,
+        shader: &Shader,
+        colors: &mut stream::Rows<[u8; 4]>,
+        totals: &mut TileTotals,
+    ) -> () => shade_rows_on
+}
+
+/// [`shade_rows`] on lanes `L`.
+#[inline(always)]
+fn shade_rows_on<L: Lanes>(
+    tile: &TileBuffer,
+    view: &View,
+    shader: &Shader,
+    rows: &mut stream::Rows<[u8; 4]>,
+    totals: &mut TileTotals,
+) {
     let [ox, oy] = tile.pattern.positions[0];
     let width = (tile.x1 - tile.x0) as usize;
+    let mut piece = [[0u8; 4]; ROW_PIECE];
     for (r, y) in (tile.y0..tile.y1).enumerate() {
         let ids = &tile.triangle_id[r * width..][..width];
         let depths = &tile.depth[r * width..][..width];
-        let colors = &mut *out.color[r];
         // A row of background alone (most rows of most frames) is one fill:
         // a planar view has a ray through every pixel. The test is a fold
         // with no early exit, which vectorizes.
         if view.sphere.is_none() && ids.iter().fold(true, |all, &id| all & (id == BACKGROUND)) {
-            colors.fill(BACKGROUND_COLOR);
+            rows.fill(r, BACKGROUND_COLOR);
             continue;
         }
-        for c0 in (0..width).step_by(8) {
-            let n = (width - c0).min(8);
-            // (Whole eights as one copy, not a call to `memcpy`.)
-            let ids8: [u32; 8] = match ids[c0..].first_chunk() {
-                Some(eight) => *eight,
-                None => std::array::from_fn(|l| ids.get(c0 + l).map_or(BACKGROUND, |&id| id)),
-            };
-            // Lanes past the row's end hold BACKGROUND: no bit there.
-            let surface = (0..8).fold(0u8, |m, l| m | u8::from(ids8[l] != BACKGROUND) << l);
-            let colors = &mut colors[c0..c0 + n];
-            if surface == 0 && view.sphere.is_none() {
-                // A planar view has a ray through every pixel.
-                colors.fill(BACKGROUND_COLOR);
-                continue;
+        for p0 in (0..width).step_by(ROW_PIECE) {
+            let colors = &mut piece[..(width - p0).min(ROW_PIECE)];
+            for c0 in (p0..p0 + colors.len()).step_by(8) {
+                let n = (width - c0).min(8);
+                let colors = &mut colors[c0 - p0..][..n];
+                shade_eight_pixels::<L>(
+                    tile,
+                    view,
+                    shader,
+                    (ids, depths),
+                    (c0, y),
+                    (ox, oy),
+                    colors,
+                    totals,
+                );
             }
-            let eight = EightSamples {
-                lanes: shader.lanes_shaded(&ids8, surface),
-                ids: ids8,
-                x: (tile.x0 + c0 as u32) as f32,
-                ox,
-                y: y as f32 + oy,
-            };
-            let (encoded, done) = match eight.lanes {
-                0 => ([[0; 4]; 8], 0),
-                _ => {
-                    let (linear, done) = shader.shade_eight::<L>(&eight);
-                    (encode_rgb_eight::<L>(linear), done)
-                }
-            };
-            totals.shading_samples += u64::from(done.count_ones());
-            // Every lane shaded here or background (a planar view's, which
-            // has a ray through every pixel): one blend and one store.
-            if done | !surface == u8::MAX && view.sphere.is_none() {
-                let blended: [[u8; 4]; 8] = std::array::from_fn(|l| match done >> l & 1 {
-                    1 => encoded[l],
-                    _ => BACKGROUND_COLOR,
-                });
-                match colors.first_chunk_mut::<8>() {
-                    Some(colors) => *colors = blended,
-                    None => colors.copy_from_slice(&blended[..n]),
-                }
-                continue;
-            }
-            let xs = eight.lane_x::<L>().to_array();
-            for (l, color) in colors.iter_mut().enumerate() {
-                let (id, at) = (eight.ids[l], (xs[l], eight.y));
-                *color = if done & (1 << l) != 0 {
-                    encoded[l]
-                } else if id == BACKGROUND {
-                    // Only non-planar viewports have pixels without a ray.
-                    match view.sphere.is_some() && view.ray(at.0, at.1).is_none() {
-                        true => OUTSIDE_VIEWPORT_COLOR,
-                        false => BACKGROUND_COLOR,
-                    }
-                } else {
-                    match view.ray(at.0, at.1) {
-                        Some(ray) => {
-                            totals.shading_samples += 1;
-                            let effects = &mut totals.effects;
-                            encode_rgb(shader.shade(id, at, ray, depths[c0 + l], effects))
-                        }
-                        None => encode_rgb(linear_rgb(OUTSIDE_VIEWPORT_COLOR)),
-                    }
-                };
-            }
+            rows.write(r, p0, colors);
         }
+    }
+}
+
+/// The colours of the (up to) eight pixels `colors` of row `y` from column
+/// `c0` on, whose samples (at offset `(ox, oy)`) hold `ids[c0..]` at
+/// `depths[c0..]`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn shade_eight_pixels<L: Lanes>(
+    tile: &TileBuffer,
+    view: &View,
+    shader: &Shader,
+    (ids, depths): (&[u32], &[f32]),
+    (c0, y): (usize, u32),
+    (ox, oy): (f32, f32),
+    colors: &mut [[u8; 4]],
+    totals: &mut TileTotals,
+) {
+    let n = colors.len();
+    // (Whole eights as one copy, not a call to `memcpy`.)
+    let ids8: [u32; 8] = match ids[c0..].first_chunk() {
+        Some(eight) => *eight,
+        None => std::array::from_fn(|l| ids.get(c0 + l).map_or(BACKGROUND, |&id| id)),
+    };
+    // Lanes past the row's end hold BACKGROUND: no bit there.
+    let surface = L::differ(ids8, BACKGROUND);
+    if surface == 0 && view.sphere.is_none() {
+        // A planar view has a ray through every pixel.
+        colors.fill(BACKGROUND_COLOR);
+        return;
+    }
+    let eight = EightSamples {
+        lanes: shader.lanes_shaded(&ids8, surface),
+        ids: ids8,
+        x: (tile.x0 + c0 as u32) as f32,
+        ox,
+        y: y as f32 + oy,
+    };
+    let (encoded, done) = match eight.lanes {
+        0 => ([[0; 4]; 8], 0),
+        _ => {
+            let (linear, done) = shader.shade_eight::<L>(&eight);
+            (encode_rgb_eight::<L>(linear), done)
+        }
+    };
+    totals.shading_samples += u64::from(done.count_ones());
+    // Every lane shaded here or background (a planar view's, which
+    // has a ray through every pixel): one blend and one store.
+    if done | !surface == u8::MAX && view.sphere.is_none() {
+        let blended: [[u8; 4]; 8] = std::array::from_fn(|l| match done >> l & 1 {
+            1 => encoded[l],
+            _ => BACKGROUND_COLOR,
+        });
+        match colors.first_chunk_mut::<8>() {
+            Some(colors) => *colors = blended,
+            None => colors.copy_from_slice(&blended[..n]),
+        }
+        return;
+    }
+    let xs = eight.lane_x::<L>().to_array();
+    for (l, color) in colors.iter_mut().enumerate() {
+        let (id, at) = (eight.ids[l], (xs[l], eight.y));
+        *color = if done & (1 << l) != 0 {
+            encoded[l]
+        } else if id == BACKGROUND {
+            // Only non-planar viewports have pixels without a ray.
+            match view.sphere.is_some() && view.ray(at.0, at.1).is_none() {
+                true => OUTSIDE_VIEWPORT_COLOR,
+                false => BACKGROUND_COLOR,
+            }
+        } else {
+            match view.ray(at.0, at.1) {
+                Some(ray) => {
+                    totals.shading_samples += 1;
+                    let effects = &mut totals.effects;
+                    encode_rgb(shader.shade(id, at, ray, depths[c0 + l], effects))
+                }
+                None => encode_rgb(linear_rgb(OUTSIDE_VIEWPORT_COLOR)),
+            }
+        };
     }
 }
 

@@ -96,6 +96,8 @@ mod sealed {
         /// Each lane's bits `shift..shift + width` moved up to `up..`, the
         /// other bits cleared: `(bits >> shift & (2^width − 1)) << up`.
         fn bit_field(self, shift: u32, width: u32, up: u32) -> Self;
+        /// Bit `l` set where `v[l] != x`.
+        fn differ(v: [u32; 8], x: u32) -> u8;
     }
 }
 
@@ -188,6 +190,10 @@ impl sealed::Ops for Portable {
     fn bit_field(self, shift: u32, width: u32, up: u32) -> Self {
         let field = |v: f32| f32::from_bits((v.to_bits() >> shift & ((1 << width) - 1)) << up);
         Self::from_array(self.to_array().map(field))
+    }
+    #[inline(always)]
+    fn differ(v: [u32; 8], x: u32) -> u8 {
+        (0..8).fold(0, |m, l| m | u8::from(v[l] != x) << l)
     }
 }
 
@@ -423,6 +429,13 @@ mod avx2_lanes {
                 let moved = _mm256_sll_epi32(kept, _mm_cvtsi32_si128(up as i32));
                 Avx2(_mm256_castsi256_ps(moved))
             })
+        }
+        #[inline(always)]
+        fn differ(v: [u32; 8], x: u32) -> u8 {
+            // SAFETY: `[u32; 8]` and `__m256i` are both 32 bytes, any bits.
+            let v = unsafe { std::mem::transmute::<[u32; 8], __m256i>(v) };
+            let same = avx!(_mm256_cmpeq_epi32(v, _mm256_set1_epi32(x as i32)));
+            !(avx!(_mm256_movemask_ps(_mm256_castsi256_ps(same))) as u8)
         }
     }
 
@@ -676,6 +689,36 @@ mod tests {
         assert_eq!(counts, expected);
         assert_eq!(groups, 2_000);
         assert!(at_end > 300, "{at_end} groups ran past the end");
+    }
+
+    dispatch! {
+        /// [`Ops::differ`] on the dispatched lanes.
+        fn differ_dispatched<>(v: [u32; 8], x: u32) -> u8 => differ_on
+    }
+
+    #[inline(always)]
+    fn differ_on<L: Lanes>(v: [u32; 8], x: u32) -> u8 {
+        L::differ(v, x)
+    }
+
+    /// `differ` marks exactly the lanes unlike its value, on both paths, for
+    /// values at the ends of `u32` (the background id among them) and between.
+    #[test]
+    fn differing_lanes_are_marked() {
+        let mut rng = fastrand::Rng::with_seed(9);
+        let mut checked = 0;
+        for _ in 0..1_000 {
+            let x = [0, u32::MAX, i32::MAX as u32 + 1, rng.u32(..)][rng.usize(0..4)];
+            let v: [u32; 8] = std::array::from_fn(|_| match rng.bool() {
+                true => x,
+                false => [0, u32::MAX, x ^ 1, rng.u32(..)][rng.usize(0..4)],
+            });
+            let expected = (0..8).fold(0u8, |m, l| m | u8::from(v[l] != x) << l);
+            assert_eq!(differ_dispatched(v, x), expected, "{v:?} {x}");
+            assert_eq!(<Portable as sealed::Ops>::differ(v, x), expected);
+            checked += 1;
+        }
+        assert_eq!(checked, 1_000);
     }
 
     /// What a gather reads: single floats, rows of three of floats and

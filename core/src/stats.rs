@@ -45,6 +45,7 @@ impl std::ops::AddAssign for CoverageHistogram {
 }
 
 impl CoverageHistogram {
+    #[inline]
     pub fn of(coverage_writes: &[u32]) -> CoverageHistogram {
         let mut h = CoverageHistogram::default();
         // Counted without a branch per pixel, in u32 that cannot overflow
