@@ -363,6 +363,7 @@ fn shade_single(
 /// Pixels a row of [`shade_rows`] is shaded in at a time, into a buffer
 /// that stays in the L1 cache, before that piece of the row is written out.
 const ROW_PIECE: usize = 256;
+const _: () = assert!(ROW_PIECE % 8 == 0);
 
 simd::dispatch! {
     /// [`shade_single`]'s colours, row by row, eight pixels of a row at a
@@ -388,7 +389,7 @@ fn shade_rows_on<L: Lanes>(
 ) {
     let [ox, oy] = tile.pattern.positions[0];
     let width = (tile.x1 - tile.x0) as usize;
-    let mut piece = [[0u8; 4]; ROW_PIECE];
+    let mut piece = [[[0u8; 4]; 8]; ROW_PIECE / 8];
     for (r, y) in (tile.y0..tile.y1).enumerate() {
         let ids = &tile.triangle_id[r * width..][..width];
         let depths = &tile.depth[r * width..][..width];
@@ -400,30 +401,27 @@ fn shade_rows_on<L: Lanes>(
             continue;
         }
         for p0 in (0..width).step_by(ROW_PIECE) {
-            let colors = &mut piece[..(width - p0).min(ROW_PIECE)];
-            for c0 in (p0..p0 + colors.len()).step_by(8) {
-                let n = (width - c0).min(8);
-                let colors = &mut colors[c0 - p0..][..n];
-                shade_eight_pixels::<L>(
+            let len = (width - p0).min(ROW_PIECE);
+            for (k, colors) in piece[..len.div_ceil(8)].iter_mut().enumerate() {
+                let at = (p0 + 8 * k, y);
+                *colors = shade_eight_pixels::<L>(
                     tile,
                     view,
                     shader,
                     (ids, depths),
-                    (c0, y),
+                    at,
                     (ox, oy),
-                    colors,
                     totals,
                 );
             }
-            rows.write(r, p0, colors);
+            rows.write(r, p0, &piece.as_flattened()[..len]);
         }
     }
 }
 
-/// The colours of the (up to) eight pixels `colors` of row `y` from column
-/// `c0` on, whose samples (at offset `(ox, oy)`) hold `ids[c0..]` at
-/// `depths[c0..]`.
-#[allow(clippy::too_many_arguments)]
+/// The colours of the eight pixels of row `y` from column `c0` on, whose
+/// samples (at offset `(ox, oy)`) hold `ids[c0..]` at `depths[c0..]`; those
+/// past the row's end are background's.
 #[inline(always)]
 fn shade_eight_pixels<L: Lanes>(
     tile: &TileBuffer,
@@ -432,10 +430,8 @@ fn shade_eight_pixels<L: Lanes>(
     (ids, depths): (&[u32], &[f32]),
     (c0, y): (usize, u32),
     (ox, oy): (f32, f32),
-    colors: &mut [[u8; 4]],
     totals: &mut TileTotals,
-) {
-    let n = colors.len();
+) -> [[u8; 4]; 8] {
     // (Whole eights as one copy, not a call to `memcpy`.)
     let ids8: [u32; 8] = match ids[c0..].first_chunk() {
         Some(eight) => *eight,
@@ -445,8 +441,7 @@ fn shade_eight_pixels<L: Lanes>(
     let surface = L::differ(ids8, BACKGROUND);
     if surface == 0 && view.sphere.is_none() {
         // A planar view has a ray through every pixel.
-        colors.fill(BACKGROUND_COLOR);
-        return;
+        return [BACKGROUND_COLOR; 8];
     }
     let eight = EightSamples {
         lanes: shader.lanes_shaded(&ids8, surface),
@@ -464,22 +459,17 @@ fn shade_eight_pixels<L: Lanes>(
     };
     totals.shading_samples += u64::from(done.count_ones());
     // Every lane shaded here or background (a planar view's, which
-    // has a ray through every pixel): one blend and one store.
+    // has a ray through every pixel): one blend.
     if done | !surface == u8::MAX && view.sphere.is_none() {
-        let blended: [[u8; 4]; 8] = std::array::from_fn(|l| match done >> l & 1 {
+        return std::array::from_fn(|l| match done >> l & 1 {
             1 => encoded[l],
             _ => BACKGROUND_COLOR,
         });
-        match colors.first_chunk_mut::<8>() {
-            Some(colors) => *colors = blended,
-            None => colors.copy_from_slice(&blended[..n]),
-        }
-        return;
     }
     let xs = eight.lane_x::<L>().to_array();
-    for (l, color) in colors.iter_mut().enumerate() {
+    std::array::from_fn(|l| {
         let (id, at) = (eight.ids[l], (xs[l], eight.y));
-        *color = if done & (1 << l) != 0 {
+        if done & (1 << l) != 0 {
             encoded[l]
         } else if id == BACKGROUND {
             // Only non-planar viewports have pixels without a ray.
@@ -496,8 +486,8 @@ fn shade_eight_pixels<L: Lanes>(
                 }
                 None => encode_rgb(linear_rgb(OUTSIDE_VIEWPORT_COLOR)),
             }
-        };
-    }
+        }
+    })
 }
 
 /// Tests: send every tile down the general path.
@@ -589,7 +579,8 @@ mod tests {
     /// (pixels without a ray); a rasterizer and the ray caster; and a
     /// sphere with every third vertex normal zero (the face normal shades
     /// its triangles); eights of one triangle (the box's faces, fig8's
-    /// floor under a second material) and of several.
+    /// floor under a second material) and of several; and, 100 pixels
+    /// wide, rows that end in part of an eight.
     #[test]
     fn the_single_sample_resolve_matches_the_general_one() {
         let names = [
@@ -629,7 +620,7 @@ mod tests {
                 (AlgorithmId::TwoDBrute, &orthographic),
                 (AlgorithmId::Raycast, &parabolic),
             ] {
-                let request = RenderRequest::new(algorithm, camera.clone(), 96, 64);
+                let request = RenderRequest::new(algorithm, camera.clone(), 100, 64);
                 let colors = |general: bool| {
                     FORCE_GENERAL.store(general, Ordering::Relaxed);
                     let out = render(&scene, &request);
@@ -644,7 +635,7 @@ mod tests {
                 rendered += 1;
                 // Rows with no triangle (a tile's, here a whole image row)
                 // take the one-fill path.
-                background_rows += (fast.2.chunks(96))
+                background_rows += (fast.2.chunks(100))
                     .filter(|row| row.iter().all(|&id| id == BACKGROUND))
                     .count();
             }

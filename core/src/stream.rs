@@ -137,11 +137,17 @@ impl<T: Word> Rows<'_, '_, T> {
             let four = [value; 4];
             // SAFETY: `four` is 16 readable bytes (unaligned load).
             let four = unsafe { _mm_loadu_si128(four.as_ptr().cast()) };
-            for out in middle {
+            // A cache line (four stores) a step, then what is left.
+            let (lines, rest) = middle.as_chunks_mut::<4>();
+            let store = |out: &mut __m128i| {
                 // SAFETY: `out` is a live, aligned `__m128i` of the row; the
                 // fence is [`streamed`]'s, as in `write`.
                 unsafe { _mm_stream_si128(out, four) };
+            };
+            for line in lines {
+                line.iter_mut().for_each(store);
             }
+            rest.iter_mut().for_each(store);
         }
         #[cfg(not(target_arch = "x86_64"))]
         row.fill(value);

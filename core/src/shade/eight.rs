@@ -174,11 +174,11 @@ impl Shader<'_> {
         // way at once. Either way every lane holds the same values, so the
         // same colour.
         let first = s.ids[done.trailing_zeros() as usize];
+        let uniform = L::differ(s.ids, first) & done == 0;
         let ids: [u32; 8] = std::array::from_fn(|l| match done & (1 << l) {
             0 => first,
             _ => s.ids[l],
         });
-        let uniform = ids.iter().all(|&id| id == first);
         // The corners only where the barycentrics or the plane distance
         // read them: the face normal is the scene's, as the scalar path
         // reads it.
