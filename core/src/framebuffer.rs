@@ -149,27 +149,20 @@ impl Framebuffer {
         pool.push(self);
     }
 
-    /// Disjoint views of the frame's planes, one per rect of `rects`: the
-    /// rows each tile resolves into. The rects must not overlap and together
-    /// cover the image (checked).
-    pub(crate) fn tile_planes(&mut self, rects: &[PixelRect]) -> Vec<TilePlanes<'_>> {
-        let (width, height) = (self.width as usize, self.height as usize);
-        let area = |r: &PixelRect| r.width() as usize * r.height() as usize;
-        assert_eq!(
-            rects.iter().map(area).sum::<usize>(),
-            width * height,
-            "the tiles must cover the image"
-        );
-        // Per row, the tiles holding it, left to right.
-        let mut rows: Vec<Vec<usize>> = vec![Vec::new(); height];
-        for (t, r) in rects.iter().enumerate() {
-            for row in &mut rows[r.y0 as usize..r.y1 as usize] {
-                row.push(t);
-            }
-        }
-        for row in &mut rows {
-            row.sort_unstable_by_key(|&t| rects[t].x0);
-        }
+    /// Disjoint views of the frame's planes, one per tile of the grid of
+    /// `size` tiles ([`Framebuffer::tile_rects`], in its order): the rows
+    /// each tile resolves into. Each row of a plane is cut into its tiles'
+    /// pieces by one `chunks_mut`.
+    pub(crate) fn tile_planes(
+        &mut self,
+        [tile_width, tile_height]: [u32; 2],
+    ) -> Vec<TilePlanes<'_>> {
+        let rects = self.tile_rects(tile_width, tile_height);
+        let grid = Grid {
+            width: self.width as usize,
+            tile: [tile_width as usize, tile_height as usize],
+            columns: self.width.div_ceil(tile_width) as usize,
+        };
         // Each tile's rows, allocated once (an optional plane the render
         // has not gets none).
         let counters = !self.edge_evals.is_empty();
@@ -191,48 +184,46 @@ impl Framebuffer {
                 }
             })
             .collect();
-        split_rows(&mut self.color, width, &rows, rects, &mut planes, |p| {
-            &mut p.color
+        grid.split(&mut self.color, &mut planes, |p| &mut p.color);
+        grid.split(&mut self.depth, &mut planes, |p| &mut p.depth);
+        grid.split(&mut self.triangle_id, &mut planes, |p| &mut p.triangle_id);
+        grid.split(&mut self.edge_evals, &mut planes, |p| &mut p.edge_evals);
+        grid.split(&mut self.coverage_writes, &mut planes, |p| {
+            &mut p.coverage_writes
         });
-        split_rows(&mut self.depth, width, &rows, rects, &mut planes, |p| {
-            &mut p.depth
+        grid.split(&mut self.sample_digest, &mut planes, |p| {
+            &mut p.sample_digest
         });
-        split_rows(
-            &mut self.triangle_id,
-            width,
-            &rows,
-            rects,
-            &mut planes,
-            |p| &mut p.triangle_id,
-        );
-        split_rows(
-            &mut self.edge_evals,
-            width,
-            &rows,
-            rects,
-            &mut planes,
-            |p| &mut p.edge_evals,
-        );
-        split_rows(
-            &mut self.coverage_writes,
-            width,
-            &rows,
-            rects,
-            &mut planes,
-            |p| &mut p.coverage_writes,
-        );
-        split_rows(
-            &mut self.sample_digest,
-            width,
-            &rows,
-            rects,
-            &mut planes,
-            |p| &mut p.sample_digest,
-        );
-        split_rows(&mut self.blended, width, &rows, rects, &mut planes, |p| {
-            &mut p.blended
-        });
+        grid.split(&mut self.blended, &mut planes, |p| &mut p.blended);
         planes
+    }
+}
+
+/// A frame `width` pixels wide cut into tiles of `tile` pixels, `columns`
+/// to a row of tiles ([`Framebuffer::tile_planes`]).
+struct Grid {
+    width: usize,
+    tile: [usize; 2],
+    columns: usize,
+}
+
+impl Grid {
+    /// Each row of `plane` cut into its tiles' pieces, each pushed onto its
+    /// tile's `field`. An empty plane (an optional buffer the render has
+    /// not) gives every tile no rows.
+    fn split<'f, T>(
+        &self,
+        plane: &'f mut [T],
+        planes: &mut [TilePlanes<'f>],
+        field: impl for<'t> Fn(&'t mut TilePlanes<'f>) -> &'t mut Vec<&'f mut [T]>,
+    ) {
+        let [tile_width, tile_height] = self.tile;
+        for (y, row) in plane.chunks_mut(self.width).enumerate() {
+            let first = y / tile_height * self.columns;
+            for (piece, tile) in row.chunks_mut(tile_width).zip(&mut planes[first..]) {
+                field(tile).push(piece);
+            }
+        }
     }
 }
 
@@ -253,34 +244,6 @@ pub(crate) struct Optional {
 const FRAME_POOL_SIZE: usize = 2;
 
 static FRAME_POOL: std::sync::Mutex<Vec<Framebuffer>> = std::sync::Mutex::new(Vec::new());
-
-/// One plane of [`Framebuffer::tile_planes`]: row `y` of `plane` cut at the
-/// borders of the tiles in `rows[y]` (left to right, not overlapping), each
-/// piece pushed onto its tile's `field`. An empty plane (an optional buffer
-/// the render has not) gives every tile no rows.
-fn split_rows<'f, T>(
-    plane: &'f mut [T],
-    width: usize,
-    rows: &[Vec<usize>],
-    rects: &[PixelRect],
-    planes: &mut [TilePlanes<'f>],
-    field: impl for<'t> Fn(&'t mut TilePlanes<'f>) -> &'t mut Vec<&'f mut [T]>,
-) {
-    if plane.is_empty() {
-        return;
-    }
-    for (row, tiles) in plane.chunks_mut(width).zip(rows) {
-        let (mut rest, mut at) = (row, 0);
-        for &t in tiles {
-            let (x0, x1) = (rects[t].x0 as usize, rects[t].x1 as usize);
-            assert!(x0 >= at, "tiles overlap in a row");
-            let (_, from_x0) = std::mem::take(&mut rest).split_at_mut(x0 - at);
-            let (piece, after) = from_x0.split_at_mut(x1 - x0);
-            field(&mut planes[t]).push(piece);
-            (rest, at) = (after, x1);
-        }
-    }
-}
 
 /// A tile's pixels in the frame's planes: row `r` of each is the tile's row
 /// `rect.y0 + r`, columns `rect.x0..rect.x1`. The resolve writes them in place;
@@ -642,6 +605,46 @@ mod tests {
     use super::*;
     use crate::aa::AaMode;
     use crate::simd::Portable;
+
+    /// The tile planes of a grid hold, row by row, exactly their tiles'
+    /// pixels — tiles cut short at the right and bottom edges included —
+    /// and every pixel of the frame lies in one tile; a plane the frame
+    /// has not (the counters of `Framebuffer::new`'s are there; the
+    /// digest is not) gives no rows.
+    #[test]
+    fn tile_planes_cut_the_frame_into_its_tiles() {
+        let mut checked = 0;
+        for ([width, height], size) in [
+            ([37, 23], [8, 5]),
+            ([64, 48], [64, 48]),
+            ([100, 7], [256, 16]),
+        ] {
+            let mut fb = Framebuffer::new(width, height);
+            for (i, id) in fb.triangle_id.iter_mut().enumerate() {
+                *id = i as u32;
+            }
+            let rects = fb.tile_rects(size[0], size[1]);
+            let planes = fb.tile_planes(size);
+            assert_eq!(planes.len(), rects.len());
+            let mut seen = vec![0u32; (width * height) as usize];
+            for (tile, rect) in planes.iter().zip(&rects) {
+                assert_eq!(tile.rect, *rect);
+                assert_eq!(tile.triangle_id.len(), rect.height() as usize);
+                assert_eq!(tile.color.len(), rect.height() as usize);
+                assert_eq!(tile.edge_evals.len(), rect.height() as usize);
+                assert!(tile.sample_digest.is_empty());
+                for (r, row) in tile.triangle_id.iter().enumerate() {
+                    let y = rect.y0 + r as u32;
+                    let expected: Vec<u32> = (rect.x0..rect.x1).map(|x| y * width + x).collect();
+                    assert_eq!(**row, expected[..]);
+                    row.iter().for_each(|&i| seen[i as usize] += 1);
+                }
+            }
+            assert!(seen.iter().all(|&n| n == 1), "every pixel in one tile");
+            checked += 1;
+        }
+        assert_eq!(checked, 3);
+    }
 
     crate::simd::dispatch! {
         fn write_eight_dispatched<>(tile: &mut TileBuffer, i: usize, mask: u8, w: &[f32; 8], id: u32) -> () => write_eight_on

@@ -356,14 +356,14 @@ fn shade_single(
     totals: &mut TileTotals,
 ) {
     stream::streamed(&mut out.color, |colors| {
-        shade_rows(tile, view, shader, colors, totals)
+        shade_rows(tile, view, shader, colors, totals);
     });
 }
 
 /// Pixels a row of [`shade_rows`] is shaded in at a time, into a buffer
 /// that stays in the L1 cache, before that piece of the row is written out.
 const ROW_PIECE: usize = 256;
-const _: () = assert!(ROW_PIECE % 8 == 0);
+const _: () = assert!(ROW_PIECE.is_multiple_of(8));
 
 simd::dispatch! {
     /// [`shade_single`]'s colours, row by row, eight pixels of a row at a

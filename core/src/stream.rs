@@ -1,10 +1,13 @@
-//! Copies into the frame's planes that bypass the cache. A frame's planes
+//! Writes into the frame's planes that bypass the cache. A frame's planes
 //! (a 1080p frame: five of 8 MB) are written once per render, tile by tile,
 //! and not read again while the lines would still be cached; a cached store
 //! first reads each line it writes from memory. Non-temporal stores write
-//! whole lines without that read: a 1080p frame's resolve, shading and store
-//! took 0.6–1.7 ms less on two threads (`continuum compare`, 3dr-brute,
-//! 3dr-full and raycast on the five benchmark scenes, alternated runs).
+//! whole lines without that read: the resolve's copies of depths and ids
+//! took a 1080p frame's resolve, shading and store 0.6–1.7 ms lower on two
+//! threads, and the shading's colours through them another 0.8–1.4 ms
+//! together with cheaper counters and fills (`scripts/ab.py` on bunny,
+//! soup, the dragon and Sponza; 2dr-brute, 3dr-brute, 3dr-full and
+//! raycast; alternated runs).
 
 /// Four-byte plain values: any bits copied from one are one.
 pub(crate) trait Word: Copy + sealed::Sealed {}

@@ -111,8 +111,8 @@ pub(super) fn resolve_bands(
     copy: impl Fn(&mut TileBuffer) + Sync,
 ) -> Pass {
     let mut pass = Pass::default();
-    let rects = fb.tile_rects(context.view.width, BAND);
-    let done = context.run_tiles(&mut pass, fb, &rects, |_, (), tile| {
+    let size = [context.view.width, BAND];
+    let done = context.run_tiles(&mut pass, fb, size, |_, (), tile| {
         copy(tile);
         crate::stats::RasterCounters::default()
     });

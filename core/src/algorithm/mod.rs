@@ -240,8 +240,8 @@ fn render_frusta<'a, T: Stored + Copy>(
     let boxes = ScreenBoxes::of_slots(scene, context.view);
     let boxes = &boxes;
     let mut pass = Pass::default();
-    let rects = fb.tile_rects(oracles.frustum, oracles.frustum);
-    let done = context.run_tiles(&mut pass, fb, &rects, |_, leaves, tile| {
+    let size = [oracles.frustum; 2];
+    let done = context.run_tiles(&mut pass, fb, size, |_, leaves, tile| {
         let how = (setup, shared, boxes);
         let mut t = Traversal::new(scene, context.view, oracles, tile, how, leaves);
         t.run();
@@ -375,9 +375,10 @@ impl<'a> TileContext<'a> {
         }
     }
 
-    /// Renders every tile of `rects` with `render` (given the tile's index, its
-    /// worker's `W`, and its sample buffers) and resolves it into `fb`'s planes;
-    /// returns the finished tiles in `rects`' order. One worker per thread of
+    /// Renders every tile of `size` pixels ([`Framebuffer::tile_rects`]) with
+    /// `render` (given the tile's index, its worker's `W`, and its sample
+    /// buffers) and resolves it into `fb`'s planes; returns the finished tiles
+    /// in the grid's order. One worker per thread of
     /// the pool, at most one per core at once (a [`gate::Gate`]), takes the
     /// next tile from a shared counter until none is left, keeping its tile
     /// buffers and its `W` (a traversal's leaf cache) from one tile to the
@@ -388,11 +389,11 @@ impl<'a> TileContext<'a> {
         &self,
         pass: &mut Pass,
         fb: &mut Framebuffer,
-        rects: &[PixelRect],
+        size: [u32; 2],
         render: impl Fn(usize, &mut W, &mut TileBuffer<'a>) -> R + Sync,
     ) -> Vec<Finished<R>> {
         let planes: Vec<_> = pass
-            .planes(fb, rects)
+            .planes(fb, size)
             .into_iter()
             .map(|p| Mutex::new(Some(p)))
             .collect();
@@ -451,15 +452,11 @@ pub(crate) struct Pass {
 }
 
 impl Pass {
-    /// The frame's planes cut into the tiles of `rects` (the time it takes
-    /// counted as the frame's `store`).
-    pub fn planes<'f>(
-        &mut self,
-        fb: &'f mut Framebuffer,
-        rects: &[PixelRect],
-    ) -> Vec<TilePlanes<'f>> {
+    /// The frame's planes cut into tiles of `size` pixels (the time it
+    /// takes counted as the frame's `store`).
+    pub fn planes<'f>(&mut self, fb: &'f mut Framebuffer, size: [u32; 2]) -> Vec<TilePlanes<'f>> {
         let start = Instant::now();
-        let planes = fb.tile_planes(rects);
+        let planes = fb.tile_planes(size);
         self.store_ms += start.elapsed().as_secs_f64() * 1e3;
         planes
     }

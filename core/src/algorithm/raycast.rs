@@ -80,8 +80,8 @@ pub(crate) fn render_raycast<'a, T: Stored>(
     // 2. Rays per sample, bands of rows in parallel, each resolved by its worker.
     let start = Instant::now();
     let mut pass = Pass::default();
-    let bands = fb.tile_rects(fb.width, packet);
-    let done = context.run_tiles(&mut pass, fb, &bands, |_, (), tile| {
+    let bands = [fb.width, packet];
+    let done = context.run_tiles(&mut pass, fb, bands, |_, (), tile| {
         // One ray group, four, or sixteen to a packet (`RAY_PACKETS`).
         match packet {
             4 => cast_band::<T, 1>(scene, view, &setups, tile),

@@ -205,9 +205,9 @@ pub(crate) fn rasterize_tiled<T: Stored>(
 
     // 2. Tiles in parallel, in input order within a tile, each resolved by
     // its worker (the samples never outlive their tile).
-    let rects = fb.tile_rects(TILE_WIDTH, TILE_HEIGHT);
     let mut pass = Pass::default();
-    let done = context.run_tiles(&mut pass, fb, &rects, |t, members: &mut Vec<u32>, tile| {
+    let size = [TILE_WIDTH, TILE_HEIGHT];
+    let done = context.run_tiles(&mut pass, fb, size, |t, members: &mut Vec<u32>, tile| {
         let mut counters = RasterCounters::default();
         // The tile's items, gathered into the worker's list (kept from tile
         // to tile).
