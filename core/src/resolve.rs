@@ -579,8 +579,9 @@ mod tests {
     /// (pixels without a ray); a rasterizer and the ray caster; and a
     /// sphere with every third vertex normal zero (the face normal shades
     /// its triangles); eights of one triangle (the box's faces, fig8's
-    /// floor under a second material) and of several; and, 100 pixels
-    /// wide, rows that end in part of an eight.
+    /// floor under a second material) and of several; and, 300 pixels
+    /// wide, rows longer than one shaded piece (`ROW_PIECE`) that end in
+    /// part of an eight.
     #[test]
     fn the_single_sample_resolve_matches_the_general_one() {
         let names = [
@@ -620,7 +621,7 @@ mod tests {
                 (AlgorithmId::TwoDBrute, &orthographic),
                 (AlgorithmId::Raycast, &parabolic),
             ] {
-                let request = RenderRequest::new(algorithm, camera.clone(), 100, 64);
+                let request = RenderRequest::new(algorithm, camera.clone(), 300, 64);
                 let colors = |general: bool| {
                     FORCE_GENERAL.store(general, Ordering::Relaxed);
                     let out = render(&scene, &request);
@@ -635,7 +636,7 @@ mod tests {
                 rendered += 1;
                 // Rows with no triangle (a tile's, here a whole image row)
                 // take the one-fill path.
-                background_rows += (fast.2.chunks(100))
+                background_rows += (fast.2.chunks(300))
                     .filter(|row| row.iter().all(|&id| id == BACKGROUND))
                     .count();
             }
