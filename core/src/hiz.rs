@@ -10,9 +10,8 @@
 //! cell along a silhouette); the mask still hides what projects onto the
 //! covered pixels alone.
 
-use wide::f32x8;
-
 use crate::ground::PixelRect;
+use crate::simd::{self, Lanes};
 
 /// Side of a hierarchical w-buffer cell in pixels (a cell's pixels are the
 /// 64 bits of its mask, row by row).
@@ -38,6 +37,13 @@ const EMPTY: Cell = Cell {
 #[derive(Clone, Debug)]
 pub(crate) struct Hiz {
     cells: Vec<Cell>,
+    /// Per cell, what [`Hiz::depths`] takes of it, kept beside the cells
+    /// as they change (a frustum's test reads them over every cell it spans,
+    /// again after every update): its farthest depth where the cell is
+    /// covered whole (`+∞` elsewhere), and its farthest held depth (`+∞`
+    /// where none is held).
+    whole: Vec<f32>,
+    held: Vec<f32>,
     rect: PixelRect,
     columns: u32,
     /// Changes whenever a cell may have: what was read from the cells
@@ -74,6 +80,8 @@ impl Hiz {
     pub fn new(rect: PixelRect) -> Hiz {
         let mut hiz = Hiz {
             cells: Vec::new(),
+            whole: Vec::new(),
+            held: Vec::new(),
             rect,
             columns: 0,
             version: 0,
@@ -90,8 +98,14 @@ impl Hiz {
         let (width, height) = (rect.width(), rect.height());
         self.columns = width.div_ceil(HIZ_CELL);
         let rows = height.div_ceil(HIZ_CELL);
+        let n = (self.columns * rows) as usize;
         self.cells.clear();
-        self.cells.resize((self.columns * rows) as usize, EMPTY);
+        self.cells.resize(n, EMPTY);
+        // No empty cell is covered whole (every cell has a pixel in the tile).
+        for summary in [&mut self.whole, &mut self.held] {
+            summary.clear();
+            summary.resize(n, f32::INFINITY);
+        }
         if self.cells.is_empty() {
             return;
         }
@@ -152,19 +166,12 @@ impl Hiz {
         let (mut farthest, mut nearest) = (f32::NEG_INFINITY, f32::INFINITY);
         for cy in cells(ly0, ly1) {
             let row = (cy * self.columns) as usize;
-            for c in &self.cells[row + columns.start as usize..row + columns.end as usize] {
-                let whole = if c.covered == u64::MAX {
-                    c.far
-                } else {
-                    f32::INFINITY
-                };
-                let held = if c.far > f32::NEG_INFINITY {
-                    c.far
-                } else {
-                    f32::INFINITY
-                };
-                farthest = farthest.max(whole);
-                nearest = nearest.min(held);
+            let span = row + columns.start as usize..row + columns.end as usize;
+            // No summary is NaN: a plain comparison is `max`/`min`, and
+            // compiles to one instruction with no branch.
+            for (&whole, &held) in self.whole[span.clone()].iter().zip(&self.held[span]) {
+                farthest = if whole > farthest { whole } else { farthest };
+                nearest = if held < nearest { held } else { nearest };
             }
         }
         (farthest, nearest)
@@ -197,81 +204,107 @@ impl Hiz {
     /// just become covered, or when `r`'s depths fell below it (the farthest
     /// may have been one of them).
     pub fn update(&mut self, r: PixelRect, depth: &[f32], pixels: usize) {
-        self.version += 1;
-        let [lx0, ly0, lx1, ly1] = self.local(r);
-        for cy in cells(ly0, ly1) {
-            for cx in cells(lx0, lx1) {
-                let (bx, by) = (cx * HIZ_CELL, cy * HIZ_CELL);
-                let (x0, x1) = span(lx0, lx1, cx);
-                let (y0, y1) = span(ly0, ly1, cy);
-                let i = (cy * self.columns + cx) as usize;
-                let old = self.cells[i];
-                let (held, far) = self.read(depth, pixels, (bx, by), (x0, x1), (y0, y1));
-                let bits = cell_bits(x0, x1, y0, y1);
-                let covered = old.covered & !bits | held;
-                let far = if covered != u64::MAX {
-                    old.far.max(far)
-                } else if old.covered == u64::MAX && far >= old.far {
-                    // The other pixels are unchanged and no farther than before.
-                    far
-                } else {
-                    self.read(depth, pixels, (bx, by), (0, HIZ_CELL), (0, HIZ_CELL))
-                        .1
-                };
-                self.cells[i] = Cell { far, covered };
-            }
-        }
+        update_cells(self, r, depth, pixels);
     }
+}
 
-    /// Over the pixel columns `x0..x1` and rows `y0..y1` of the cell at
-    /// tile-local `origin` (clipped to the tile): the mask bits of the pixels
-    /// whose every sample holds a depth, and the farthest depth held — over
-    /// whole rows of the cell where it lies inside the tile (one load of eight
-    /// lanes): the other pixels of those rows are unchanged since the last
-    /// update, so no farther than the cell's farthest depth (which
-    /// [`Hiz::update`] compares with).
-    #[inline]
-    fn read(
-        &self,
-        depth: &[f32],
-        pixels: usize,
-        (bx, by): (u32, u32),
-        (x0, x1): (u32, u32),
-        (y0, y1): (u32, u32),
-    ) -> (u64, f32) {
-        let width = self.rect.width();
-        let columns = HIZ_CELL.min(width - bx);
-        let (x1, y1) = (x1.min(columns), y1.min(self.rect.height() - by));
-        let lanes = (0xff >> (8 - (x1 - x0))) << x0;
-        let empty = f32x8::splat(f32::NEG_INFINITY);
-        let mut far = empty;
-        let mut held = 0u64;
-        let layers = depth.len() / pixels;
-        for row in y0..y1 {
-            let start = ((by + row) * width + bx) as usize;
-            let mut row_held = lanes;
-            for layer in 0..layers {
-                let start = layer * pixels + start;
-                let v = if columns == HIZ_CELL {
-                    f32x8::from(std::array::from_fn(|k| depth[start + k]))
-                } else {
-                    f32x8::from(std::array::from_fn(|k| {
-                        if (k as u32) < columns {
-                            depth[start + k]
-                        } else {
-                            f32::NEG_INFINITY
-                        }
-                    }))
-                };
-                let finite = v.is_finite();
-                row_held &= finite.to_bitmask();
-                far = far.fast_max(finite.bitselect(v, empty));
-            }
-            held |= u64::from(row_held) << (8 * row);
+simd::dispatch! {
+    /// [`Hiz::update`] on the lanes of this CPU: a row of a cell is one
+    /// load of eight lanes.
+    fn update_cells<>(hiz: &mut Hiz, r: PixelRect, depth: &[f32], pixels: usize) -> ()
+        => update_cells_on
+}
+
+/// [`update_cells`] on lanes `L`.
+#[inline(always)]
+fn update_cells_on<L: Lanes>(hiz: &mut Hiz, r: PixelRect, depth: &[f32], pixels: usize) {
+    hiz.version += 1;
+    let [lx0, ly0, lx1, ly1] = hiz.local(r);
+    for cy in cells(ly0, ly1) {
+        for cx in cells(lx0, lx1) {
+            let (bx, by) = (cx * HIZ_CELL, cy * HIZ_CELL);
+            let (x0, x1) = span(lx0, lx1, cx);
+            let (y0, y1) = span(ly0, ly1, cy);
+            let i = (cy * hiz.columns + cx) as usize;
+            let old = hiz.cells[i];
+            let (held, far) = read::<L>(hiz.rect, depth, pixels, (bx, by), (x0, x1), (y0, y1));
+            let bits = cell_bits(x0, x1, y0, y1);
+            let covered = old.covered & !bits | held;
+            let far = if covered != u64::MAX {
+                old.far.max(far)
+            } else if old.covered == u64::MAX && far >= old.far {
+                // The other pixels are unchanged and no farther than before.
+                far
+            } else {
+                let whole = (0, HIZ_CELL);
+                read::<L>(hiz.rect, depth, pixels, (bx, by), whole, whole).1
+            };
+            hiz.cells[i] = Cell { far, covered };
+            hiz.whole[i] = if covered == u64::MAX {
+                far
+            } else {
+                f32::INFINITY
+            };
+            hiz.held[i] = if far > f32::NEG_INFINITY {
+                far
+            } else {
+                f32::INFINITY
+            };
         }
-        let far = far.to_array().into_iter().fold(f32::NEG_INFINITY, f32::max);
-        (held, far)
     }
+}
+
+/// Over the pixel columns `x0..x1` and rows `y0..y1` of the cell at
+/// tile-local `(bx, by)` of the tile over `rect` (clipped to it): the mask
+/// bits of the pixels whose every sample holds a depth, and the farthest
+/// depth held — over whole rows of the cell where it lies inside the tile
+/// (one load of eight lanes): the other pixels of those rows are unchanged
+/// since the last update, so no farther than the cell's farthest depth
+/// (which [`Hiz::update`] compares with).
+#[inline(always)]
+fn read<L: Lanes>(
+    rect: PixelRect,
+    depth: &[f32],
+    pixels: usize,
+    (bx, by): (u32, u32),
+    (x0, x1): (u32, u32),
+    (y0, y1): (u32, u32),
+) -> (u64, f32) {
+    let width = rect.width();
+    let columns = HIZ_CELL.min(width - bx);
+    let (x1, y1) = (x1.min(columns), y1.min(rect.height() - by));
+    let lanes = (0xff >> (8 - (x1 - x0))) << x0;
+    let empty = L::splat(f32::NEG_INFINITY);
+    let mut far = empty;
+    let mut held = 0u64;
+    let layers = depth.len() / pixels;
+    for row in y0..y1 {
+        let start = ((by + row) * width + bx) as usize;
+        let mut row_held = lanes;
+        for layer in 0..layers {
+            let start = layer * pixels + start;
+            // A whole row of the cell is one load with one bounds check.
+            let whole = (columns == HIZ_CELL)
+                .then(|| depth.get(start..)?.first_chunk::<8>())
+                .flatten();
+            let v = match whole {
+                Some(&row) => L::from_array(row),
+                None => L::from_array(std::array::from_fn(|k| {
+                    if (k as u32) < columns {
+                        depth[start + k]
+                    } else {
+                        f32::NEG_INFINITY
+                    }
+                })),
+            };
+            let finite = simd::finite(v);
+            row_held &= finite;
+            far = far.max(L::select(finite, v, empty));
+        }
+        held |= u64::from(row_held) << (8 * row);
+    }
+    let far = far.to_array().into_iter().fold(f32::NEG_INFINITY, f32::max);
+    (held, far)
 }
 
 #[cfg(test)]
@@ -437,6 +470,11 @@ mod tests {
                     }
                 }
                 assert_eq!(hiz.farthest(q), farthest, "case {case}: {q:?} in {rect:?}");
+                // The nearest held farthest depth, from the cells themselves.
+                let nearest = (hiz.touched(q).map(|(c, _)| c.far))
+                    .filter(|&far| far > f32::NEG_INFINITY)
+                    .fold(f32::INFINITY, f32::min);
+                assert_eq!(hiz.depths(q).1, nearest, "case {case}: {q:?} in {rect:?}");
                 let at = rng.f32() * 11.0;
                 if hiz.hides(q, at) {
                     hidden += 1;
@@ -454,5 +492,57 @@ mod tests {
         }
         assert_eq!(checked, 60 * 200);
         assert!(hidden > 1000, "{hidden} hidden");
+    }
+
+    /// The dispatched update (AVX2 where the CPU has it) leaves every cell
+    /// as the portable lanes do, bit for bit: random writes and updates over
+    /// tiles of one to three layers, with edge cells narrower than eight
+    /// pixels and whole cells read again.
+    #[test]
+    fn both_lane_sets_update_the_cells_alike() {
+        #[cfg(target_arch = "x86_64")]
+        assert!(
+            simd::cpu_has_avx2(),
+            "this test checks the AVX2 kernel, and this CPU has no AVX2"
+        );
+        let mut rng = fastrand::Rng::with_seed(11);
+        let (mut compared, mut narrow) = (0, 0);
+        for case in 0..40 {
+            let rect = PixelRect::new(0, 8, rng.u32(1..45), 8 + rng.u32(1..30));
+            let (w, h) = (rect.width(), rect.height());
+            narrow += usize::from(w % HIZ_CELL != 0);
+            let layers = 1 + case % 3;
+            let pixels = (w * h) as usize;
+            let mut depth = vec![f32::INFINITY; pixels * layers];
+            let (mut dispatched, mut portable) = (Hiz::new(rect), Hiz::new(rect));
+            for _ in 0..150 {
+                let (x0, y0) = (rng.u32(0..w), rng.u32(0..h));
+                let (x1, y1) = (rng.u32(x0 + 1..=w), rng.u32(y0 + 1..=h));
+                let r = PixelRect::new(x0, rect.y0 + y0, x1, rect.y0 + y1);
+                for y in y0..y1 {
+                    for x in x0..x1 {
+                        for layer in 0..layers {
+                            let i = layer * pixels + (y * w + x) as usize;
+                            if rng.u32(0..3) > 0 {
+                                depth[i] = depth[i].min(rng.f32() * 10.0);
+                            }
+                        }
+                    }
+                }
+                dispatched.update(r, &depth, pixels);
+                update_cells_on::<simd::Portable>(&mut portable, r, &depth, pixels);
+                let bits = |hiz: &Hiz| -> Vec<(u32, u64)> {
+                    hiz.cells
+                        .iter()
+                        .map(|c| (c.far.to_bits(), c.covered))
+                        .collect()
+                };
+                assert_eq!(bits(&dispatched), bits(&portable), "case {case}: {r:?}");
+                assert_eq!(dispatched.version(), portable.version());
+                compared += 1;
+            }
+        }
+        assert_eq!(compared, 40 * 150);
+        assert!(narrow > 20, "{narrow} tiles with a narrow edge cell");
     }
 }
