@@ -24,7 +24,7 @@ use crate::ground::PixelRect;
 use crate::pipeline::TraversalOracles;
 use crate::prepared::PreparedScene;
 use crate::screen_boxes::{ScreenBoxes, rects_eight};
-use crate::simd::{self, Lanes, Portable};
+use crate::simd::{self, Lanes};
 use crate::stats::RasterCounters;
 use crate::trace::{FrustumEvent, NodeOutcome};
 
@@ -182,28 +182,39 @@ fn dot(d: Vec3A, n: Vec3A) -> f32 {
 /// distance, and which boxes lie wholly outside a side plane or nearer than
 /// `near` — the same tests, rounded the same way, as [`NodeBox`] and
 /// `Traversal::is_outside` make for one box.
-struct ChildTests<L> {
-    boxes: Children<L>,
-    min_w: L,
+#[derive(Debug, PartialEq)]
+struct ChildTests {
+    /// Per axis, the child boxes' bounds, a lane per child slot.
+    lo: [[f32; 8]; 3],
+    hi: [[f32; 8]; 3],
+    min_w: [f32; 8],
     /// Bit per child slot (empty slots included: the caller skips them).
     outside: u8,
 }
 
-impl<L: Lanes> ChildTests<L> {
-    #[inline(always)]
-    fn of(node: &CwBvhNode, frustum: &Frustum, v: &View) -> ChildTests<L> {
-        let boxes = Children::<L>::decode(node);
-        let eye = Vec3A::from(v.eye);
-        let fw = Vec3A::from(v.forward);
-        let mut outside = along(&boxes, eye, fw, true).lt(L::splat(v.near));
-        for &(n, offset) in &frustum.planes {
-            outside |= along(&boxes, eye, n, true).lt(L::splat(offset));
-        }
-        ChildTests {
-            min_w: along(&boxes, eye, fw, false),
-            boxes,
-            outside,
-        }
+simd::dispatch! {
+    /// [`ChildTests`] of `node` against `frustum`, in the lanes of this CPU.
+    fn child_tests<>(node: &CwBvhNode, frustum: &Frustum, v: &View) -> ChildTests
+        => child_tests_on
+}
+
+#[inline(always)]
+fn child_tests_on<L: Lanes>(node: &CwBvhNode, frustum: &Frustum, v: &View) -> ChildTests {
+    let boxes = Children::<L>::decode(node);
+    let eye = Vec3A::from(v.eye);
+    let fw = Vec3A::from(v.forward);
+    let mut outside = along(&boxes, eye, fw, true).lt(L::splat(v.near));
+    for &(n, offset) in &frustum.planes {
+        outside |= along(&boxes, eye, n, true).lt(L::splat(offset));
+    }
+    // (No closure around a lane operation: it would be compiled without the
+    // lanes' instruction set.)
+    let [lo, hi] = [boxes.lo, boxes.hi];
+    ChildTests {
+        lo: [lo[0].to_array(), lo[1].to_array(), lo[2].to_array()],
+        hi: [hi[0].to_array(), hi[1].to_array(), hi[2].to_array()],
+        min_w: along(&boxes, eye, fw, false).to_array(),
+        outside,
     }
 }
 
@@ -260,6 +271,43 @@ impl Frustum {
             planes: planes.map(|(n, offset)| (Vec3A::from(n), offset)),
             centre: SlabRay::new(v.origin(cx, cy), v.direction(cx, cy)),
         }
+    }
+}
+
+/// A child's place in the visiting order as one integer: its nearest
+/// distance `w` in [`f32::total_cmp`]'s order (the sign bit flipped on
+/// positive values, every bit on negative ones), then its slot — ordered
+/// as a stable sort of the children by distance orders them, with no
+/// comparison closure in the sort.
+#[inline]
+fn visiting_key(w: f32, slot: u8) -> u64 {
+    let bits = w.to_bits();
+    let ordered = if bits >> 31 == 1 {
+        !bits
+    } else {
+        bits | 1 << 31
+    };
+    u64::from(ordered) << 8 | u64::from(slot)
+}
+
+/// The slot of a [`visiting_key`].
+#[inline]
+fn visited_slot(key: u64) -> usize {
+    (key & 0xff) as usize
+}
+
+/// Sorts a node's (at most eight, distinct) visiting keys in place, by
+/// insertion.
+#[inline]
+fn sort_keys(keys: &mut [u64]) {
+    for i in 1..keys.len() {
+        let key = keys[i];
+        let mut j = i;
+        while j > 0 && keys[j - 1] > key {
+            keys[j] = keys[j - 1];
+            j -= 1;
+        }
+        keys[j] = key;
     }
 }
 
@@ -397,24 +445,20 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
     /// visited one by one.
     fn visit_children(&mut self, frustum: &Frustum, index: u32) {
         let n = &self.scene.bvh.cwbvh.nodes[index as usize];
-        let tests = ChildTests::<Portable>::of(n, frustum, self.view);
+        let tests = child_tests(n, frustum, self.view);
         let outside = if self.oracles.outside {
             tests.outside
         } else {
             0
         };
-        let (lo, hi) = (
-            tests.boxes.lo.map(|l| l.to_array()),
-            tests.boxes.hi.map(|l| l.to_array()),
-        );
-        let min_w = tests.min_w.to_array();
-        // Sorted as (distance, slot) pairs (stable: ties keep slot order),
-        // each child's box and reference made when it is visited.
-        let mut order = [(0.0f32, 0u8); 8];
+        let ChildTests { lo, hi, min_w, .. } = tests;
+        // Sorted by distance, ties in slot order ([`visiting_key`]), each
+        // child's box and reference made when it is visited.
+        let mut order = [0u64; 8];
         let (mut len, mut present) = (0, 0u8);
         for (c, &w) in min_w.iter().enumerate() {
             if !n.is_child_empty(c) {
-                order[len] = (w, c as u8);
+                order[len] = visiting_key(w, c as u8);
                 len += 1;
                 present |= 1 << c;
             }
@@ -425,13 +469,13 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
             present,
             rects: std::cell::OnceCell::new(),
         };
-        order[..len].sort_by(|a, b| a.0.total_cmp(&b.0));
+        sort_keys(&mut order[..len]);
         // What the children inside the frustum will read first is on its way
         // while the nearest is visited: an inner child's node, a leaf's
         // vertex indices and corners (each a likely miss on a large scene).
         let scene = self.scene;
-        for &(_, c) in &order[..len] {
-            let c = usize::from(c);
+        for &key in &order[..len] {
+            let c = visited_slot(key);
             if outside >> c & 1 == 1 {
                 continue;
             }
@@ -449,8 +493,9 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
                 simd::prefetch(child);
             }
         }
-        for &(min_w, c) in &order[..len] {
-            let c = usize::from(c);
+        for &key in &order[..len] {
+            let c = visited_slot(key);
+            let min_w = min_w[c];
             let r = if n.is_leaf(c) {
                 let (start, count) = n.child_primitives(c);
                 NodeRef::Leaf {
@@ -664,5 +709,108 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
             // Occlusion culling reads the hierarchical w-buffer: keep it current.
             self.tile.update_hiz(f);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Viewport;
+
+    /// The visiting keys sort a node's children as a stable sort by
+    /// [`f32::total_cmp`] of their distances does: random distances with
+    /// ties, both zeros, negative values, infinities and NaNs, one to eight
+    /// children in any slots.
+    #[test]
+    fn visiting_keys_order_children_as_a_stable_sort_by_distance() {
+        let mut rng = fastrand::Rng::with_seed(5);
+        let special = [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            -f32::NAN,
+        ];
+        let (mut checked, mut ties) = (0, 0);
+        for _ in 0..5000 {
+            let len = rng.usize(1..=8);
+            let mut slots: Vec<u8> = (0..8).collect();
+            rng.shuffle(&mut slots);
+            slots.truncate(len);
+            slots.sort_unstable();
+            let children: Vec<(f32, u8)> = (slots.iter())
+                .map(|&c| match rng.u32(0..3) {
+                    0 => (special[rng.usize(..special.len())], c),
+                    1 => (rng.u32(0..3) as f32, c),
+                    _ => ((rng.f32() - 0.5) * 100.0, c),
+                })
+                .collect();
+            let mut expected = children.clone();
+            expected.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut keys: Vec<u64> = (children.iter())
+                .map(|&(w, c)| visiting_key(w, c))
+                .collect();
+            sort_keys(&mut keys);
+            let got: Vec<usize> = keys.iter().map(|&k| visited_slot(k)).collect();
+            let want: Vec<usize> = expected.iter().map(|&(_, c)| usize::from(c)).collect();
+            assert_eq!(got, want, "{children:?}");
+            checked += 1;
+            ties +=
+                usize::from((1..len).any(|i| expected[i - 1].0.total_cmp(&expected[i].0).is_eq()));
+        }
+        assert_eq!(checked, 5000);
+        assert!(ties > 500, "{ties} sets with equal distances");
+    }
+
+    /// The dispatched child tests (AVX2 where the CPU has it) are the
+    /// portable lanes' bit for bit, at every inner node of the soup's BVH
+    /// against frusta of random rects, under perspective and orthographic
+    /// views.
+    #[test]
+    fn both_lane_sets_test_children_alike() {
+        #[cfg(target_arch = "x86_64")]
+        assert!(
+            simd::cpu_has_avx2(),
+            "this test checks the AVX2 kernel, and this CPU has no AVX2"
+        );
+        let path = format!("{}/../scenes/soup.toml", env!("CARGO_MANIFEST_DIR"));
+        let scene = crate::scene::load_path(path.as_ref()).expect("built-in scene loads");
+        let scene = PreparedScene::new(scene);
+        let camera = scene.scene.first_camera();
+        let orthographic = crate::Camera {
+            viewport: Viewport::Orthographic {
+                height: scene.bounds.radius(),
+            },
+            ..camera.clone()
+        };
+        let nodes = &scene.bvh.cwbvh.nodes;
+        let mut rng = fastrand::Rng::with_seed(9);
+        let (mut compared, mut outside) = (0, 0);
+        for camera in [&camera, &orthographic] {
+            let view = View::new(camera, 320, 240, scene.default_near).expect("a valid camera");
+            for _ in 0..20 {
+                let (x0, y0) = (rng.u32(0..320), rng.u32(0..240));
+                let rect = PixelRect::new(x0, y0, rng.u32(x0 + 1..=320), rng.u32(y0 + 1..=240));
+                let frustum = Frustum::new(rect, &view);
+                for node in nodes {
+                    let portable = child_tests_on::<simd::Portable>(node, &frustum, &view);
+                    let dispatched = child_tests(node, &frustum, &view);
+                    // Debug shows the sign of a zero, which `==` does not.
+                    assert_eq!(
+                        format!("{dispatched:?}"),
+                        format!("{portable:?}"),
+                        "{rect:?}"
+                    );
+                    outside += portable.outside.count_ones();
+                    compared += 1;
+                }
+            }
+        }
+        assert!(nodes.len() > 100, "{} nodes", nodes.len());
+        assert_eq!(compared, 40 * nodes.len());
+        assert!(outside > 1000, "{outside} children outside");
     }
 }
