@@ -136,7 +136,7 @@ impl Hiz {
 
     /// Each cell that the pixels of the non-empty `r` (inside the tile)
     /// touch, with the mask bits of `r`'s pixels in it.
-    #[inline]
+    #[cfg(test)]
     fn touched(&self, r: PixelRect) -> impl Iterator<Item = (&Cell, u64)> {
         let [lx0, ly0, lx1, ly1] = self.local(r);
         cells(ly0, ly1).flat_map(move |cy| {
@@ -190,8 +190,22 @@ impl Hiz {
     /// a tie only where `w` equals the stored depth, so nothing at `w` or
     /// farther can be seen there.)
     pub fn hides(&self, r: PixelRect, w: f32) -> bool {
-        self.touched(r)
-            .all(|(c, bits)| c.covered & bits == bits && w > c.far)
+        // Loops, not `touched`'s iterators: a frustum's tests call this for
+        // most nodes they do not cull by distance alone.
+        let [lx0, ly0, lx1, ly1] = self.local(r);
+        for cy in cells(ly0, ly1) {
+            let (y0, y1) = span(ly0, ly1, cy);
+            for cx in cells(lx0, lx1) {
+                let (x0, x1) = span(lx0, lx1, cx);
+                let c = &self.cells[(cy * self.columns + cx) as usize];
+                let bits = cell_bits(x0, x1, y0, y1);
+                let hidden = c.covered & bits == bits && w > c.far;
+                if !hidden {
+                    return false;
+                }
+            }
+        }
+        true
     }
 
     /// Brings the cells that the pixels of `r` touch up to date after writes

@@ -663,6 +663,28 @@ pub(crate) fn prefetch<T: ?Sized>(value: &T) {
     let _ = value;
 }
 
+/// [`prefetch`] of a few values spanning at most 128 bytes (a BVH leaf's
+/// records): hints at its first byte, 64 bytes on and its last byte —
+/// every line such a span touches — with no loop over its length.
+#[inline(always)]
+pub(crate) fn prefetch_short<T>(values: &[T]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let first = values.as_ptr().cast::<i8>();
+        let last = size_of_val(values).saturating_sub(1);
+        debug_assert!(last < 128, "a short span");
+        // SAFETY: as in `prefetch`: a hint that neither reads nor faults.
+        let hint =
+            |offset: usize| unsafe { _mm_prefetch::<_MM_HINT_T0>(first.wrapping_add(offset)) };
+        hint(0);
+        hint(last.min(64));
+        hint(last);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = values;
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -486,8 +486,8 @@ impl<'a, 't, T: Stored + Copy> Traversal<'a, 't, T> {
                     scene.slot_vertices.get(slots.clone()),
                     scene.slot_corners.get(slots),
                 ) {
-                    simd::prefetch(v);
-                    simd::prefetch(p);
+                    simd::prefetch_short(v);
+                    simd::prefetch_short(p);
                 }
             } else if let Some(child) = scene.bvh.cwbvh.nodes.get(n.child_node_index(c) as usize) {
                 simd::prefetch(child);
