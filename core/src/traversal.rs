@@ -182,7 +182,7 @@ fn dot(d: Vec3A, n: Vec3A) -> f32 {
 /// distance, and which boxes lie wholly outside a side plane or nearer than
 /// `near` — the same tests, rounded the same way, as [`NodeBox`] and
 /// `Traversal::is_outside` make for one box.
-#[derive(Debug, PartialEq)]
+#[derive(Debug)]
 struct ChildTests {
     /// Per axis, the child boxes' bounds, a lane per child slot.
     lo: [[f32; 8]; 3],
