@@ -127,8 +127,12 @@ simd::dispatch! {
 fn setup_3d_block_on<L: Lanes>(mesh: &LaneMesh, ids: &[u32], run: Option<u32>) -> Block {
     debug_assert!(!ids.is_empty() && ids.len() <= BLOCK);
     let (mut boxes, mut triangles) = ([ItemBox::NONE; BLOCK], [None; BLOCK]);
-    // The items with a box not yet set up: their records, and where they are.
-    let (mut packed, mut at, mut n) = ([0u32; 8], [0usize; 8], 0);
+    // The items with a box not yet set up: their records, and where they
+    // are. Every lane of an eight is written and the count steps by whether
+    // it has a box, so at most fifteen wait (the lanes with a box are as
+    // many as no predictor foresees: a branch per lane missed a third of
+    // the time on the teapots).
+    let (mut packed, mut at, mut n) = ([0u32; 16], [0usize; 16], 0);
     for (e, eight) in ids.chunks(8).enumerate() {
         // Each lane's record (past the chunk's end, its last one).
         let items = match run {
@@ -140,18 +144,20 @@ fn setup_3d_block_on<L: Lanes>(mesh: &LaneMesh, ids: &[u32], run: Option<u32>) -
         };
         let rects = rects_eight_lanes::<L>(mesh, items, eight.len());
         let [x0, y0, x1, y1] = rects.bounds::<L>();
-        let mut some = rects.some;
-        while some != 0 {
-            let l = some.trailing_zeros() as usize;
-            some &= some - 1;
-            let rect = PixelRect::new(x0[l], y0[l], x1[l], y1[l]);
-            boxes[e * 8 + l] = ItemBox::new(rect, eight[l]);
+        // Lanes past the chunk's end have no box (nor a place in `boxes`
+        // beyond the block's items: those are dropped by `flattened`).
+        for l in 0..8 {
+            let keep = rects.some >> l & 1 == 1;
+            let id = eight[l.min(eight.len() - 1)];
+            boxes[e * 8 + l] = ItemBox::kept([x0[l], y0[l], x1[l], y1[l]], id, keep);
             (packed[n], at[n]) = (items[l], e * 8 + l);
-            n += 1;
-            if n == 8 {
-                set_up_packed::<L>(mesh, &packed, &at, 8, (&mut boxes, &mut triangles));
-                n = 0;
-            }
+            n += usize::from(keep);
+        }
+        if n >= 8 {
+            set_up_packed::<L>(mesh, &packed, &at, 8, (&mut boxes, &mut triangles));
+            packed.copy_within(8.., 0);
+            at.copy_within(8.., 0);
+            n -= 8;
         }
     }
     if n > 0 {
@@ -177,19 +183,20 @@ fn rects_eight_lanes<L: Lanes>(mesh: &LaneMesh, items: [u32; 8], n: usize) -> Pi
     )
 }
 
-/// The first `n` of the eight triangles with records `items` (the last one
-/// repeated past them), each with a box, set up in lanes
-/// ([`Triangle3D::setup_lanes`]) into item `at[l]` of the block; an item
-/// whose setup is `None` loses its box.
+/// The first `n` (at most eight) of the triangles with records `items`
+/// (the last one repeated past them up to eight), each with a box, set up
+/// in lanes ([`Triangle3D::setup_lanes`]) into item `at[l]` of the block;
+/// an item whose setup is `None` loses its box.
 #[inline(always)]
 fn set_up_packed<L: Lanes>(
     mesh: &LaneMesh,
-    items: &[u32; 8],
-    at: &[usize; 8],
+    items: &[u32; 16],
+    at: &[usize; 16],
     n: usize,
     (boxes, triangles): (&mut [ItemBox; BLOCK], &mut [Option<Triangle3D>; BLOCK]),
 ) {
-    let vertices = simd::gather_xyz_u32::<L>(mesh.records, 3, *items);
+    let items = *items.first_chunk::<8>().expect("16 > 8");
+    let vertices = simd::gather_xyz_u32::<L>(mesh.records, 3, items);
     let flat = bytemuck::cast_slice(mesh.positions);
     let corners = [
         L::gather_xyz(flat, 3, vertices[0]),
@@ -197,13 +204,16 @@ fn set_up_packed<L: Lanes>(
         L::gather_xyz(flat, 3, vertices[2]),
     ];
     let corners_of = |l: usize| vertices.map(|v| mesh.positions[v[l] as usize]);
-    let set_up = Triangle3D::setup_lanes(&corners, first_lanes(n), mesh.view, corners_of);
-    for l in 0..n {
-        match set_up[l] {
+    Triangle3D::setup_lanes(
+        &corners,
+        first_lanes(n),
+        mesh.view,
+        corners_of,
+        |l, set_up| match set_up {
             Some(triangle) => triangles[at[l]] = Some(triangle),
             None => boxes[at[l]] = ItemBox::NONE,
-        }
-    }
+        },
+    );
 }
 
 simd::dispatch! {
@@ -233,7 +243,10 @@ fn leaf_setups_3d_on<L: Lanes>(
         L::gather_xyz(&flat[3..], 9, slots),
         L::gather_xyz(&flat[6..], 9, slots),
     ];
-    Triangle3D::setup_lanes(&lanes, wanted, view, |l| corners[slots[l] as usize])
+    let mut out = [None; 8];
+    let corners_of = |l: usize| corners[slots[l] as usize];
+    Triangle3D::setup_lanes(&lanes, wanted, view, corners_of, |l, t| out[l] = t);
+    out
 }
 
 /// [`leaf_setups_3d`] in f64, one at a time ([`Triangle3D64::setup`]).

@@ -80,6 +80,24 @@ impl ItemBox {
         }
     }
 
+    /// Triangle `id`'s pixel bounds `[x0, y0, x1, y1]` (a non-empty box
+    /// within an image) where `keep`, else [`ItemBox::NONE`], with no
+    /// branch: the lanes of a setup write every box, kept or not.
+    #[inline(always)]
+    pub(crate) fn kept(bounds: [u32; 4], id: u32, keep: bool) -> ItemBox {
+        let [x0, y0, x1, y1] = bounds;
+        debug_assert!(!keep || (x0 < x1 && y0 < y1 && x1.max(y1) <= u32::from(u16::MAX)));
+        let k = u32::from(keep);
+        let side = |v: u32| (v * k) as u16;
+        ItemBox {
+            x0: side(x0),
+            y0: side(y0),
+            x1: side(x1),
+            y1: side(y1),
+            id: id * k,
+        }
+    }
+
     /// The box and the triangle's id, or `None` when there is nothing to test.
     #[inline(always)]
     pub(crate) fn get(self) -> Option<(PixelRect, u32)> {

@@ -136,6 +136,12 @@ impl Tolerances {
         kept(t[0]) | kept(t[1]) << 10 | kept(t[2]) << 20 | u32::from(negated) << 30
     }
 
+    /// The word's bits as a float (a record's sixteenth word).
+    #[inline(always)]
+    pub(super) fn as_word(self) -> f32 {
+        f32::from_bits(self.0.get())
+    }
+
     /// Edge `k`'s tolerance.
     #[inline(always)]
     pub(crate) fn get(self, k: usize) -> f32 {
@@ -1108,7 +1114,7 @@ impl Triangle3D {
     #[inline(always)]
     fn words(&self) -> [[f32; 8]; 2] {
         let (a, b, c, k) = (self.a, self.b, self.c, self.varying);
-        let tolerance = f32::from_bits(self.tolerance.0.get());
+        let tolerance = self.tolerance.as_word();
         [
             [a[0], a[1], a[2], b[0], b[1], b[2], c[0], c[1]],
             [
@@ -1122,6 +1128,22 @@ impl Triangle3D {
                 tolerance,
             ],
         ]
+    }
+
+    /// The record of sixteen words in [`Triangle3D::words`]' order.
+    #[inline(always)]
+    pub(super) fn from_words([first, second]: [[f32; 8]; 2]) -> Triangle3D {
+        let [a0, a1, a2, b0, b1, b2, c0, c1] = first;
+        let [c2, k0, k1, k2, constant, w_min, w_max, tolerance] = second;
+        Triangle3D {
+            a: [a0, a1, a2],
+            b: [b0, b1, b2],
+            c: [c0, c1, c2],
+            varying: [k0, k1, k2],
+            constant,
+            w_range: [w_min, w_max],
+            tolerance: Tolerances(ALWAYS_SET | tolerance.to_bits()),
+        }
     }
 }
 

@@ -16,7 +16,7 @@ use super::EightTriangles;
 use super::edge3d::{BOUND_MARGIN, EPS, HomogeneousVertex, SCALE_ABOVE, Tolerances, Triangle3D};
 use super::homogeneous::setup_homogeneous_from;
 use crate::camera::View;
-use crate::simd::{self, Lanes};
+use crate::simd::{self, Lanes, Portable};
 
 impl Triangle3D {
     /// The triangles of `t` set up for `view`, each exactly as
@@ -26,19 +26,20 @@ impl Triangle3D {
     }
 
     /// [`Triangle3D::setup_eight`] of triangles whose corners are in lanes
-    /// already (per vertex, per axis), for the lanes of `present`;
-    /// `corners(l)` gives lane `l`'s corners to the scalar setup where the
-    /// lanes cannot decide.
+    /// already (per vertex, per axis), for the lanes of `present`, each
+    /// lane's setup given to `put`; `corners(l)` gives lane `l`'s corners to
+    /// the scalar setup where the lanes cannot decide.
     #[inline(always)]
     pub(crate) fn setup_lanes<L: Lanes>(
         c: &[[L; 3]; 3],
         present: u8,
         view: &View,
         corners: impl Fn(usize) -> [Vec3; 3],
-    ) -> [Option<Triangle3D>; 8] {
+        put: impl FnMut(usize, Option<Triangle3D>),
+    ) {
         let [c0, c1, c2] = [V::of(c[0]), V::of(c[1]), V::of(c[2])];
         let s = planar_of(c0, c1, c2, view);
-        assembled(present, &s, |l| Triangle3D::setup(&corners(l), view))
+        assembled::<L>(present, &s, |l| Triangle3D::setup(&corners(l), view), put);
     }
 
     /// The triangles of `t` set up for homogeneous 2D rasterization from
@@ -76,7 +77,10 @@ fn homogeneous_eight_with(
         }
     }
     let s = kernel(&h, &w, view);
-    assembled(t.present, &s, |l| setup_homogeneous_from(vertices(l), view))
+    let mut out = [None; 8];
+    let scalar = |l| setup_homogeneous_from(vertices(l), view);
+    assembled::<Portable>(t.present, &s, scalar, |l, t| out[l] = t);
+    out
 }
 
 /// Vertex, axis, lane.
@@ -106,40 +110,56 @@ fn setup_eight_with(
         }
     }
     let s = kernel(&corners, view);
-    assembled(present, &s, |l| Triangle3D::setup(p[l], view))
+    let mut out = [None; 8];
+    let scalar = |l| Triangle3D::setup(p[l], view);
+    assembled::<Portable>(present, &s, scalar, |l, t| out[l] = t);
+    out
 }
 
-/// The present lanes' triangles from what the lanes computed: a decided
-/// lane's values as they are, an undecided one set up by `scalar`.
+/// The present lanes' triangles from what the lanes computed, each given
+/// to `put` with its lane: a decided lane's values as they are, an
+/// undecided one set up by `scalar`. The records are the lanes' sixteen
+/// fields turned into each lane's sixteen words by two transposes
+/// ([`Triangle3D::from_words`]), where copying them field by field took
+/// some sixty instructions a triangle.
 #[inline(always)]
-fn assembled(
+fn assembled<L: Lanes>(
     present: u8,
     s: &LaneSetups,
     scalar: impl Fn(usize) -> Option<Triangle3D>,
-) -> [Option<Triangle3D>; 8] {
-    let mut out = [None; 8];
-    let tolerances = Tolerances::eight(&s.tolerance, s.negated);
-    for (l, out) in out.iter_mut().enumerate() {
+    mut put: impl FnMut(usize, Option<Triangle3D>),
+) {
+    // `w_range` lane by lane in the scalar order of operations (min and max
+    // of ±0 or NaN keep the scalar record's bits).
+    let (mut near, mut far) = ([0.0; 8], [0.0; 8]);
+    for l in 0..8 {
+        let w = [s.w[0][l], s.w[1][l], s.w[2][l]];
+        (near[l], far[l]) = (w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2]));
+    }
+    let tolerances = Tolerances::eight(&s.tolerance, s.negated).map(Tolerances::as_word);
+    let [e0, e1, e2] = &s.edges;
+    let [first, second] = [
+        L::transpose([e0[0], e1[0], e2[0], e0[1], e1[1], e2[1], e0[2], e1[2]]),
+        L::transpose([
+            e2[2], s.nd[0], s.nd[1], s.nd[2], s.volume, near, far, tolerances,
+        ]),
+    ];
+    for l in 0..8 {
         if present >> l & 1 == 0 {
             continue;
         }
-        if s.decided >> l & 1 == 0 {
-            *out = scalar(l);
-            continue;
-        }
-        let edge = |j: usize| [s.edges[0][j][l], s.edges[1][j][l], s.edges[2][j][l]];
-        let w = [s.w[0][l], s.w[1][l], s.w[2][l]];
-        *out = Some(Triangle3D {
-            a: edge(0),
-            b: edge(1),
-            c: edge(2),
-            varying: [s.nd[0][l], s.nd[1][l], s.nd[2][l]],
-            constant: s.volume[l],
-            w_range: [w[0].min(w[1]).min(w[2]), w[0].max(w[1]).max(w[2])],
-            tolerance: tolerances[l],
-        });
+        put(
+            l,
+            if s.decided >> l & 1 == 0 {
+                scalar(l)
+            } else {
+                Some(Triangle3D::from_words([
+                    first[l].to_array(),
+                    second[l].to_array(),
+                ]))
+            },
+        );
     }
-    out
 }
 
 /// What eight lanes of a setup computed, lane last.
