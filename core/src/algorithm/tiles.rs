@@ -159,11 +159,17 @@ struct TileGrid {
 }
 
 impl TileGrid {
-    /// Calls `f` with the index of every tile that the non-empty `r` reaches.
+    /// Calls `f` with the index of every tile that the non-empty `r` reaches,
+    /// row by row. A box in one tile (nearly every box of a mesh of small
+    /// triangles) takes no loop: the loops' exits, one to four tiles wide
+    /// as no predictor foresees, were mispredicted every few boxes.
     #[inline(always)]
     fn each(&self, r: &PixelRect, mut f: impl FnMut(usize)) {
         let (tx0, tx1) = (r.x0 / TILE_WIDTH, (r.x1 - 1) / TILE_WIDTH);
         let (ty0, ty1) = (r.y0 / TILE_HEIGHT, (r.y1 - 1) / TILE_HEIGHT);
+        if tx0 == tx1 && ty0 == ty1 {
+            return f(ty0 as usize * self.columns + tx0 as usize);
+        }
         for ty in ty0..=ty1 {
             let row = ty as usize * self.columns;
             for tx in tx0..=tx1 {
