@@ -5,8 +5,8 @@ on a noisy machine.
   scripts/ab.py SCENES ALGORITHMS ROUNDS LABEL=BINARY LABEL=BINARY ... [-- COMPARE_FLAGS]
 
 Each round runs `BINARY compare --scenes SCENES --algorithms ALGORITHMS --size 1920x1080
---threads 2 --repeat 5 COMPARE_FLAGS` once per binary, in turn, so that a machine that
-slows down slows every binary alike. Prints per scene, algorithm and binary the median
+--threads 2 --repeat 5 COMPARE_FLAGS` once per binary, in turn (each round starting with
+the next binary), so that a machine that slows down slows every binary alike. Prints per scene, algorithm and binary the median
 over the rounds of each row's median time, with its stages: setup (s), traversal +
 coverage (t) and resolve + shading + store (f), in ms; and names every row whose hashes
 differ between the binaries (a speed change keeps every image)."""
@@ -29,8 +29,12 @@ def main(args):
     binaries = [a.split("=", 1) for a in args[3:]]
     flags = ["--size", "1920x1080", "--threads", "2", "--repeat", "5", *extra]
     times, hashes = {}, {}
-    for _ in range(rounds):
-        for label, binary in binaries:
+    for round_ in range(rounds):
+        # Each round starts with the next binary: whichever runs first in a
+        # round (after the machine was idle, or after another program) is
+        # not always the same one.
+        shift = round_ % len(binaries)
+        for label, binary in binaries[shift:] + binaries[:shift]:
             with tempfile.TemporaryDirectory() as out:
                 command = [binary, "compare", "--scenes", scenes, "--algorithms", algorithms, *flags, "--out", out]
                 subprocess.run(command, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
