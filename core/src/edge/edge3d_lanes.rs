@@ -148,17 +148,15 @@ fn assembled<L: Lanes>(
         if present >> l & 1 == 0 {
             continue;
         }
-        put(
-            l,
-            if s.decided >> l & 1 == 0 {
-                scalar(l)
-            } else {
-                Some(Triangle3D::from_words([
-                    first[l].to_array(),
-                    second[l].to_array(),
-                ]))
-            },
-        );
+        // A call per branch: `put` writes the record where it goes, not a
+        // value picked between the two (one the branches met in, built in
+        // pieces and read back whole, which the CPU cannot forward).
+        if s.decided >> l & 1 == 0 {
+            put(l, scalar(l));
+        } else {
+            let words = [first[l].to_array(), second[l].to_array()];
+            put(l, Some(Triangle3D::from_words(words)));
+        }
     }
 }
 
