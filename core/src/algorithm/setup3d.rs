@@ -82,6 +82,9 @@ fn set_up_in_lanes<'a>(
         .enumerate()
         .for_each(|(block, ((ids, boxes), triangles))| {
             let run = by_slot.then_some((block * BLOCK) as u32);
+            // The block writes every box again; filling them first (768
+            // bytes, in cache) is what lets `set_len` below rest on this
+            // function alone, not on the block's code.
             let boxes = filled(boxes, ItemBox::NONE);
             let triangles = filled(triangles, None);
             setup_3d_block(mesh, ids, run, boxes, triangles);
